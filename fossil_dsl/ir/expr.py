@@ -1,0 +1,332 @@
+"""Solver-neutral real-valued expressions: immutable, hashable, exact (Fraction) numbers.
+
+Every later stage (solvers, learner, printers) consumes these; none of them sees the
+syntax tree. Simplification is limited to exact constant folding.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Callable, Mapping
+
+MAX_CONSTANT_BITS = 20_000  # exact constants beyond this are rejected, not computed
+
+
+class ExprError(ValueError):
+    """An expression that cannot be built exactly (division by zero, a huge constant)."""
+
+
+class Expr:
+    """Base class; operators build new nodes with constant folding."""
+
+    def __add__(self, other): return add(self, lift(other))
+    def __radd__(self, other): return add(lift(other), self)
+    def __sub__(self, other): return add(self, neg(lift(other)))
+    def __rsub__(self, other): return add(lift(other), neg(self))
+    def __mul__(self, other): return mul(self, lift(other))
+    def __rmul__(self, other): return mul(lift(other), self)
+    def __truediv__(self, other): return div(self, lift(other))
+    def __rtruediv__(self, other): return div(lift(other), self)
+    def __pow__(self, other): return power(self, lift(other))
+    def __neg__(self): return neg(self)
+
+    def __str__(self) -> str:
+        from fossil_dsl.ir.printing import to_text
+        return to_text(self)
+
+
+@dataclass(frozen=True, eq=True)
+class Num(Expr):
+    value: Fraction
+
+    def __post_init__(self):
+        if not isinstance(self.value, Fraction):
+            object.__setattr__(self, "value", Fraction(self.value))
+
+
+@dataclass(frozen=True)
+class Var(Expr):
+    name: str
+
+
+@dataclass(frozen=True)
+class Pi(Expr):
+    """The exact constant π."""
+
+
+@dataclass(frozen=True)
+class Add(Expr):
+    terms: tuple[Expr, ...]
+
+
+@dataclass(frozen=True)
+class Mul(Expr):
+    factors: tuple[Expr, ...]
+
+
+@dataclass(frozen=True)
+class Div(Expr):
+    numerator: Expr
+    denominator: Expr
+
+
+@dataclass(frozen=True)
+class Neg(Expr):
+    operand: Expr
+
+
+@dataclass(frozen=True)
+class Pow(Expr):
+    base: Expr
+    exponent: Expr
+
+
+@dataclass(frozen=True)
+class Apply(Expr):
+    """A named function of one argument, from FUNCTIONS."""
+
+    func: str
+    arg: Expr
+
+
+ZERO = Num(Fraction(0))
+ONE = Num(Fraction(1))
+
+
+def lift(value) -> Expr:
+    if isinstance(value, Expr):
+        return value
+    if isinstance(value, (int, Fraction)):
+        return Num(Fraction(value))
+    if isinstance(value, float):
+        return Num(Fraction(value))
+    raise TypeError(f"cannot make an expression of {value!r}")
+
+
+def _checked(value: Fraction) -> Num:
+    if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > MAX_CONSTANT_BITS:
+        raise ExprError("constant too large to compute exactly")
+    return Num(value)
+
+
+def is_num(expr: Expr, value=None) -> bool:
+    return isinstance(expr, Num) and (value is None or expr.value == value)
+
+
+# ---- smart constructors (exact folding of rational constants) -----------------------
+def add(*terms: Expr) -> Expr:
+    flat: list[Expr] = []
+    constant = Fraction(0)
+    for term in terms:
+        for part in (term.terms if isinstance(term, Add) else (term,)):
+            if isinstance(part, Num):
+                constant += part.value
+            else:
+                flat.append(part)
+    if constant != 0 or not flat:
+        flat.append(_checked(constant))
+    return flat[0] if len(flat) == 1 else Add(tuple(flat))
+
+
+def mul(*factors: Expr) -> Expr:
+    flat: list[Expr] = []
+    constant = Fraction(1)
+    for factor in factors:
+        for part in (factor.factors if isinstance(factor, Mul) else (factor,)):
+            if isinstance(part, Num):
+                constant = _checked(constant * part.value).value
+            else:
+                flat.append(part)
+    if constant == 0:
+        return ZERO
+    if constant == -1 and flat:
+        return neg(flat[0] if len(flat) == 1 else Mul(tuple(flat)))
+    if constant != 1 or not flat:
+        flat.insert(0, Num(constant))
+    return flat[0] if len(flat) == 1 else Mul(tuple(flat))
+
+
+def neg(operand: Expr) -> Expr:
+    if isinstance(operand, Num):
+        return Num(-operand.value)
+    if isinstance(operand, Neg):
+        return operand.operand
+    return Neg(operand)
+
+
+def div(numerator: Expr, denominator: Expr) -> Expr:
+    if is_num(denominator, 0):
+        raise ExprError("division by zero")
+    if isinstance(denominator, Num):
+        return mul(numerator, Num(1 / denominator.value))
+    if is_num(numerator, 0):
+        return ZERO
+    return Div(numerator, denominator)
+
+
+MAX_EXPONENT = 10_000
+
+
+def power(base: Expr, exponent: Expr) -> Expr:
+    if isinstance(exponent, Num) and exponent.value.denominator == 1:
+        n = exponent.value.numerator
+        if abs(n) > MAX_EXPONENT:
+            raise ExprError(f"exponent {n} is too large (at most {MAX_EXPONENT})")
+        if n == 1:
+            return base
+        if n == 0:
+            return ONE
+        if isinstance(base, Num):
+            return _fold_power(base.value, n)
+    return Pow(base, exponent)
+
+
+def _fold_power(base: Fraction, n: int) -> Num:
+    if base == 0 and n < 0:
+        raise ExprError("division by zero (0 to a negative power)")
+    bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length())
+    if bits * abs(n) > MAX_CONSTANT_BITS:
+        raise ExprError("constant too large to compute exactly")
+    return Num(base ** n)
+
+
+def apply(func: str, arg: Expr) -> Expr:
+    exact = FUNCTIONS[func].exact(arg)
+    return exact if exact is not None else Apply(func, arg)
+
+
+# ---- the functions of the language ----------------------------------------------
+@dataclass(frozen=True)
+class Function:
+    """A function the language allows; `exact` folds it where the value is rational."""
+
+    name: str
+    exact: Callable[[Expr], Expr | None]
+    piecewise_linear: bool = False  # abs: expressible in linear arithmetic with ite
+
+
+def _at_zero(value: int) -> Callable[[Expr], Expr | None]:
+    return lambda arg: Num(Fraction(value)) if is_num(arg, 0) else None
+
+
+def _exact_log(arg: Expr) -> Expr | None:
+    if is_num(arg) and arg.value <= 0:
+        raise ExprError("log of a non-positive number")
+    return ZERO if is_num(arg, 1) else None
+
+
+def _exact_sqrt(arg: Expr) -> Expr | None:
+    if not isinstance(arg, Num):
+        return None
+    if arg.value < 0:
+        raise ExprError("sqrt of a negative number")
+    num, den = arg.value.numerator, arg.value.denominator
+    root_n, root_d = _isqrt_exact(num), _isqrt_exact(den)
+    return Num(Fraction(root_n, root_d)) if root_n is not None and root_d is not None else None
+
+
+def _isqrt_exact(n: int) -> int | None:
+    import math
+    root = math.isqrt(n)
+    return root if root * root == n else None
+
+
+def _exact_abs(arg: Expr) -> Expr | None:
+    return Num(abs(arg.value)) if isinstance(arg, Num) else None
+
+
+FUNCTIONS: Mapping[str, Function] = {f.name: f for f in (
+    Function("sin", _at_zero(0)),
+    Function("cos", _at_zero(1)),
+    Function("tan", _at_zero(0)),
+    Function("exp", _at_zero(1)),
+    Function("log", _exact_log),
+    Function("sqrt", _exact_sqrt),
+    Function("tanh", _at_zero(0)),
+    Function("atan", _at_zero(0)),
+    Function("abs", _exact_abs, piecewise_linear=True),
+)}
+
+
+# ---- traversal ------------------------------------------------------------------
+def children(expr: Expr) -> tuple[Expr, ...]:
+    if isinstance(expr, Add):
+        return expr.terms
+    if isinstance(expr, Mul):
+        return expr.factors
+    if isinstance(expr, Div):
+        return (expr.numerator, expr.denominator)
+    if isinstance(expr, Pow):
+        return (expr.base, expr.exponent)
+    if isinstance(expr, (Neg,)):
+        return (expr.operand,)
+    if isinstance(expr, Apply):
+        return (expr.arg,)
+    return ()
+
+
+def walk(expr: Expr):
+    """Every node of the tree, parents before children."""
+    stack = [expr]
+    while stack:
+        node = stack.pop()
+        yield node
+        stack.extend(children(node))
+
+
+def free_vars(expr: Expr) -> frozenset[str]:
+    return frozenset(node.name for node in walk(expr) if isinstance(node, Var))
+
+
+def substitute(expr: Expr, mapping: Mapping[str, Expr]) -> Expr:
+    """Replace variables by expressions, folding constants on the way up."""
+    if isinstance(expr, Var):
+        return mapping.get(expr.name, expr)
+    if isinstance(expr, (Num, Pi)):
+        return expr
+    return rebuild(expr, tuple(substitute(child, mapping) for child in children(expr)))
+
+
+def rebuild(expr: Expr, new_children: tuple[Expr, ...]) -> Expr:
+    """The same node over new children, through the folding constructors."""
+    if isinstance(expr, Add):
+        return add(*new_children)
+    if isinstance(expr, Mul):
+        return mul(*new_children)
+    if isinstance(expr, Div):
+        return div(*new_children)
+    if isinstance(expr, Pow):
+        return power(*new_children)
+    if isinstance(expr, Neg):
+        return neg(new_children[0])
+    if isinstance(expr, Apply):
+        return apply(expr.func, new_children[0])
+    return expr
+
+
+def is_polynomial(expr: Expr) -> bool:
+    """+, -, * and non-negative integer powers only, over rational constants."""
+    for node in walk(expr):
+        if isinstance(node, (Apply, Pi, Div)):
+            return False
+        if isinstance(node, Pow) and not _natural_exponent(node.exponent):
+            return False
+    return True
+
+
+def is_arithmetic(expr: Expr) -> bool:
+    """Decidable by nonlinear real arithmetic: polynomials, division, integer powers, abs."""
+    for node in walk(expr):
+        if isinstance(node, Pi):
+            return False
+        if isinstance(node, Apply) and not FUNCTIONS[node.func].piecewise_linear:
+            return False
+        if isinstance(node, Pow) and not (isinstance(node.exponent, Num)
+                                          and node.exponent.value.denominator == 1):
+            return False
+    return True
+
+
+def _natural_exponent(exponent: Expr) -> bool:
+    return isinstance(exponent, Num) and exponent.value.denominator == 1 \
+        and exponent.value >= 0

@@ -1,0 +1,149 @@
+"""Solver-neutral boolean formulas over expressions: comparisons, and, or, not."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fossil_dsl.ir.expr import Expr, free_vars as expr_free_vars, substitute as expr_substitute
+
+RELATIONS = ("<=", "<", ">=", ">")
+
+
+class Formula:
+    def __and__(self, other): return conjunction(self, other)
+    def __or__(self, other): return disjunction(self, other)
+    def __invert__(self): return negation(self)
+
+    def __str__(self) -> str:
+        from fossil_dsl.ir.printing import formula_text
+        return formula_text(self)
+
+
+@dataclass(frozen=True)
+class Compare(Formula):
+    relation: str  # one of RELATIONS
+    left: Expr
+    right: Expr
+
+
+@dataclass(frozen=True)
+class And(Formula):
+    args: tuple[Formula, ...]
+
+
+@dataclass(frozen=True)
+class Or(Formula):
+    args: tuple[Formula, ...]
+
+
+@dataclass(frozen=True)
+class Not(Formula):
+    arg: Formula
+
+
+@dataclass(frozen=True)
+class BoolConst(Formula):
+    value: bool
+
+
+TRUE = BoolConst(True)
+FALSE = BoolConst(False)
+
+
+def conjunction(*args: Formula) -> Formula:
+    flat: list[Formula] = []
+    for arg in args:
+        if arg == FALSE:
+            return FALSE
+        if arg != TRUE:
+            flat.extend(arg.args if isinstance(arg, And) else (arg,))
+    if not flat:
+        return TRUE
+    return flat[0] if len(flat) == 1 else And(tuple(flat))
+
+
+def disjunction(*args: Formula) -> Formula:
+    flat: list[Formula] = []
+    for arg in args:
+        if arg == TRUE:
+            return TRUE
+        if arg != FALSE:
+            flat.extend(arg.args if isinstance(arg, Or) else (arg,))
+    if not flat:
+        return FALSE
+    return flat[0] if len(flat) == 1 else Or(tuple(flat))
+
+
+def negation(arg: Formula) -> Formula:
+    if isinstance(arg, BoolConst):
+        return BoolConst(not arg.value)
+    if isinstance(arg, Not):
+        return arg.arg
+    return Not(arg)
+
+
+_STRICT = {"<=": "<", ">=": ">", "<": "<", ">": ">"}
+_LOOSE = {"<": "<=", ">": ">=", "<=": "<=", ">=": ">="}
+_FLIPPED = {"<=": ">", "<": ">=", ">=": "<", ">": "<="}
+
+
+def open_inner(formula: Formula) -> Formula:
+    """An open set inside the set that `formula` describes (all comparisons strict).
+
+    For continuous expressions, {g < h} is open, and a set of points satisfying every
+    strict comparison lies in the interior; negations flip to closed supersets.
+    """
+    return _approximate(formula, _STRICT, _LOOSE)
+
+
+def closed_outer(formula: Formula) -> Formula:
+    """A closed set containing the set that `formula` describes."""
+    return _approximate(formula, _LOOSE, _STRICT)
+
+
+def _approximate(formula: Formula, same: dict, dual: dict) -> Formula:
+    if isinstance(formula, Compare):
+        return Compare(same[formula.relation], formula.left, formula.right)
+    if isinstance(formula, And):
+        return conjunction(*(_approximate(a, same, dual) for a in formula.args))
+    if isinstance(formula, Or):
+        return disjunction(*(_approximate(a, same, dual) for a in formula.args))
+    if isinstance(formula, Not):
+        return negation(_approximate(formula.arg, dual, same))
+    return formula
+
+
+def children(formula: Formula) -> tuple[Formula, ...]:
+    if isinstance(formula, (And, Or)):
+        return formula.args
+    if isinstance(formula, Not):
+        return (formula.arg,)
+    return ()
+
+
+def comparisons(formula: Formula):
+    stack = [formula]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Compare):
+            yield node
+        stack.extend(children(node))
+
+
+def free_vars(formula: Formula) -> frozenset[str]:
+    names: set[str] = set()
+    for comparison in comparisons(formula):
+        names |= expr_free_vars(comparison.left) | expr_free_vars(comparison.right)
+    return frozenset(names)
+
+
+def substitute(formula: Formula, mapping) -> Formula:
+    if isinstance(formula, Compare):
+        return Compare(formula.relation, expr_substitute(formula.left, mapping),
+                       expr_substitute(formula.right, mapping))
+    if isinstance(formula, And):
+        return conjunction(*(substitute(a, mapping) for a in formula.args))
+    if isinstance(formula, Or):
+        return disjunction(*(substitute(a, mapping) for a in formula.args))
+    if isinstance(formula, Not):
+        return negation(substitute(formula.arg, mapping))
+    return formula

@@ -1,0 +1,37 @@
+"""What every verifier backend offers: satisfiability of a neutral formula, with a
+model when SAT, and honest UNKNOWN (with its reason) otherwise."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from fractions import Fraction
+from typing import Mapping, Protocol, Sequence
+
+from fossil_dsl.diagnostics import FslError
+from fossil_dsl.ir.logic import Formula
+
+
+class Status(Enum):
+    SAT = "sat"
+    UNSAT = "unsat"
+    UNKNOWN = "unknown"
+
+
+@dataclass(frozen=True)
+class Answer:
+    status: Status
+    model: Mapping[str, Fraction] | None = None
+    reason: str = ""
+    approximate: bool = False  # the query bounded irrational constants by intervals
+
+
+class UnsupportedTheory(FslError):
+    """The backend cannot express part of the formula (for example sin(x) in Z3)."""
+
+
+class Backend(Protocol):
+    name: str
+
+    def check(self, formula: Formula, variables: Sequence[str], timeout: float) -> Answer:
+        """Is `formula` satisfiable over the reals? `variables` are reported in the model."""
+        ...

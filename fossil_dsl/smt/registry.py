@@ -1,0 +1,57 @@
+"""Verifier backends by name, imported only when used (a missing solver never breaks
+the others). A new backend is one module with one class plus one entry here."""
+from __future__ import annotations
+
+import importlib
+import importlib.util
+from dataclasses import dataclass
+
+from fossil_dsl.diagnostics import FslError
+from fossil_dsl.smt.api import Backend
+
+
+@dataclass(frozen=True)
+class BackendInfo:
+    name: str
+    module: str  # fossil_dsl module holding the class
+    class_name: str
+    requires: str  # the Python package the backend needs
+    transcendental: bool  # can decide sin, exp, ... (possibly delta-complete)
+    summary: str
+
+
+BACKENDS: dict[str, BackendInfo] = {b.name: b for b in (
+    BackendInfo("z3", "fossil_dsl.smt.z3_backend", "Z3Backend", "z3", False,
+                "Z3, complete for polynomial real arithmetic"),
+    BackendInfo("cvc5", "fossil_dsl.smt.cvc5_backend", "Cvc5Backend", "cvc5", True,
+                "CVC5, polynomial arithmetic and some transcendental queries"),
+    BackendInfo("dreal", "fossil_dsl.smt.dreal_backend", "DrealBackend", "dreal", True,
+                "dReal, delta-complete for transcendental functions (optional)"),
+    BackendInfo("interval", "fossil_dsl.smt.interval_backend", "IntervalBackend", "codac",
+                True, "a delta-decision procedure on outward-rounded interval arithmetic"),
+)}
+
+
+class BackendUnavailable(FslError):
+    pass
+
+
+def names() -> tuple[str, ...]:
+    return tuple(BACKENDS)
+
+
+def is_installed(name: str) -> bool:
+    info = BACKENDS[name]
+    return (importlib.util.find_spec(info.requires) is not None
+            and importlib.util.find_spec(info.module) is not None)
+
+
+def load(name: str) -> Backend:
+    info = BACKENDS[name]
+    if not is_installed(name):
+        others = ", ".join(n for n in BACKENDS if n != name and is_installed(n))
+        raise BackendUnavailable(
+            f"verifier `{name}` is not available on this machine (it needs the Python "
+            f"package `{info.requires}`); available: {others}")
+    module = importlib.import_module(info.module)
+    return getattr(module, info.class_name)()

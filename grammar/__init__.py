@@ -1,0 +1,1 @@
+"""The .fsl grammar (fsl.lark), shipped inside the wheel as package data."""
