@@ -63,7 +63,8 @@ MAX_SHOWN_LINE = 200
 
 
 def _caret_lines(source: Source, span: Span) -> list[str]:
-    text = source.line_text(span.line).expandtabs(1)
+    text = "".join(c if c.isprintable() else "?" for c in
+                   source.line_text(span.line).expandtabs(1))
     if not text.strip():
         return []
     start = max(span.column - 1, 0)
@@ -83,6 +84,10 @@ def error(message: str, span: Span | None = None, *notes: str) -> Diagnostic:
 
 def warning(message: str, span: Span | None = None, *notes: str) -> Diagnostic:
     return Diagnostic(Severity.WARNING, message, span, tuple(notes))
+
+
+def article(noun: str) -> str:
+    return f"{'an' if noun[:1] in 'aeiou' else 'a'} {noun}"
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:

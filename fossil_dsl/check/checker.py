@@ -10,10 +10,10 @@ from typing import Sequence
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
 from fossil_dsl.check.options import OptionReader
-from fossil_dsl.check.properties import PropertyChecker, PropertyForm
+from fossil_dsl.check.properties import PropertyChecker, PropertyForm, formula_set_names
 from fossil_dsl.check.relations import RelationProver, SetLabel, check_equilibrium
 from fossil_dsl.check.sets import SetChecker
-from fossil_dsl.diagnostics import Diagnostic, Span, has_errors
+from fossil_dsl.diagnostics import Diagnostic, Span, article, has_errors
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.spec import CheckedSpec, Property, TimeDomain
@@ -190,7 +190,7 @@ class Checker:
 
     def _not_a_state(self, ident: ast.Ident) -> None:
         kind = self.context.kind_of(ident.text)
-        what = f"a {kind}" if kind else "not declared"
+        what = article(kind) if kind else "not declared"
         self.context.error(f"`{ident.text}` is {what}; equations are for states "
                            f"({', '.join(self.context.states) or 'none declared'})",
                            ident.span)
@@ -209,6 +209,8 @@ class Checker:
 
     def check_property(self, sets: SetChecker) -> tuple[Property, PropertyForm] | None:
         decl = self.singles.get("prove")
+        if decl is not None:
+            self.context.used.update(formula_set_names(decl.formula))
         if decl is None or sets.domain is None:
             return None
         return PropertyChecker(self.context, sets).check(decl)

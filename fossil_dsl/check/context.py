@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from fossil_dsl.diagnostics import Diagnostic, Span, error, warning
+from fossil_dsl.diagnostics import Diagnostic, Span, article, error, warning
 from fossil_dsl.ir.expr import Expr
 from fossil_dsl.syntax import ast
 
@@ -34,7 +34,7 @@ class CheckContext:
         previous = self.names.get(ident.text)
         if previous is not None:
             where = previous.ident.span
-            self.error(f"`{ident.text}` is already declared as a {previous.kind} "
+            self.error(f"`{ident.text}` is already declared as {article(previous.kind)} "
                        f"at {where.line}:{where.column}", ident.span)
             return False
         self.names[ident.text] = Declared(kind, ident)

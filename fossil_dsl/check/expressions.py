@@ -8,7 +8,7 @@ from fractions import Fraction
 from typing import Iterable
 
 from fossil_dsl.check.context import CheckContext
-from fossil_dsl.diagnostics import did_you_mean
+from fossil_dsl.diagnostics import article, did_you_mean
 from fossil_dsl.ir import expr as E
 from fossil_dsl.syntax import ast
 
@@ -96,7 +96,7 @@ class ExpressionChecker:
         self.context.used.add(node.name)
         if kind not in self.allowed:
             self.context.error(
-                f"`{node.name}` is a {kind}; here only {_ALLOWED_WORDS[self.where]} "
+                f"`{node.name}` is {article(kind)}; here only {_ALLOWED_WORDS[self.where]} "
                 "may be used", node.span)
             return E.ZERO
         if kind == "constant":
@@ -120,7 +120,8 @@ class ExpressionChecker:
         if name not in E.FUNCTIONS:
             kind = self.context.kind_of(name)
             if kind:
-                self.context.error(f"`{name}` is a {kind}, not a function", node.func.span)
+                self.context.error(f"`{name}` is {article(kind)}, not a function",
+                                   node.func.span)
             else:
                 self.context.error(f"unknown function `{name}`"
                                    f"{did_you_mean(name, E.FUNCTIONS)}; the functions are: "

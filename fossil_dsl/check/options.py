@@ -106,16 +106,24 @@ class OptionReader:
     def samples(self, option: ast.Option) -> SampleCounts:
         if len(option.items) == 1 and not isinstance(option.items[0], ast.NamedCount):
             return SampleCounts(default=self.count(option.items[0]))
-        per_set = {}
+        per_set, valid = {}, True
         for item in option.items:
-            if not isinstance(item, ast.NamedCount):
-                self.fail("write `samples: N` or `samples: SET N, ...`", item.span)
-            name = item.name.text
-            if name != "domain" and name not in self.set_names:
-                self.fail(f"`{name}` is not a declared set"
-                          f"{did_you_mean(name, self.set_names | {'domain'})}", item.name.span)
-            per_set[name] = self.count(item.count)
+            try:
+                per_set.update(self.named_count(item))
+            except Invalid:
+                valid = False
+        if not valid:
+            raise Invalid
         return SampleCounts(per_set=MappingProxyType(per_set))
+
+    def named_count(self, item) -> dict[str, int]:
+        if not isinstance(item, ast.NamedCount):
+            self.fail("write `samples: N` or `samples: SET N, ...`", item.span)
+        name = item.name.text
+        if name != "domain" and name not in self.set_names:
+            self.fail(f"`{name}` is not a declared set"
+                      f"{did_you_mean(name, self.set_names | {'domain'})}", item.name.span)
+        return {name: self.count(item.count)}
 
     def count(self, item) -> int:
         value = self.numbers.convert(item)

@@ -249,6 +249,10 @@ def _letter_roles(letter, value, negated, domain) -> dict:
     return {"safe": value, "unsafe": S.Complement(value, domain)}
 
 
+def formula_set_names(formula: ast.Formula) -> set[str]:
+    return set(_literal_spans(formula))
+
+
 def _literal_spans(formula: ast.Formula) -> dict[str, Span]:
     spans: dict[str, Span] = {}
     stack = [formula]

@@ -77,8 +77,8 @@ class RelationProver:
         witness = self._query(query, claim, a.span)
         if witness is not None:
             self.context.error(f"{a.text} is not inside the interior of {b.text}: "
-                               f"{point_text(witness)} is in {a.text} but not in the "
-                               f"interior of {b.text}", a.span)
+                               f"{point_text(witness)} is in {a.text} but on the boundary "
+                               "or outside", a.span)
 
     def disjoint(self, first: S.SetExpr, second: S.SetExpr) -> None:
         a, b = self.label(first), self.label(second)
@@ -127,7 +127,7 @@ def check_equilibrium(context: CheckContext, states: Sequence[str], inputs: Sequ
         try:
             at_origin = E.substitute(value, zeros)
         except E.ExprError as exc:
-            context.error(f"the dynamics are undefined at the origin ({exc}): {lhs}", span)
+            context.error(f"{lhs} = {to_text(value)} is undefined at the origin ({exc})", span)
             continue
         verdict = sign(at_origin) if not E.free_vars(at_origin) else None
         if verdict == 0:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
-from fossil_dsl.diagnostics import Span, did_you_mean
+from fossil_dsl.diagnostics import Span, article, did_you_mean
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.syntax import ast
@@ -79,7 +79,7 @@ class SetChecker:
             return self.named(node.name, node.span)
         kind = self.context.kind_of(node.name)
         if kind:
-            self.context.error(f"`{node.name}` is a {kind}, not a set", node.span)
+            self.context.error(f"`{node.name}` is {article(kind)}, not a set", node.span)
         else:
             hint = did_you_mean(node.name, self.declarations)
             self.context.error(f"undeclared set `{node.name}`{hint}", node.span)

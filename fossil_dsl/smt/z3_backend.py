@@ -21,6 +21,7 @@ class Z3Converter:
         self.context = context
         self.variables: dict[str, z3.ArithRef] = {}
         self.side_conditions: list[z3.BoolRef] = []
+        self.constants: dict[E.Expr, z3.ArithRef] = {}  # the same constant, one variable
 
     def var(self, name: str) -> z3.ArithRef:
         if name not in self.variables:
@@ -78,12 +79,15 @@ class Z3Converter:
         return 1 / result if n < 0 else result
 
     def _enclosed_constant(self, expr: E.Expr) -> z3.ArithRef:
+        if expr in self.constants:
+            return self.constants[expr]
         enclosure = bounds(expr)
         if enclosure is None:
             raise UnsupportedTheory(f"cannot bound the constant `{expr}`")
         fresh = z3.FreshReal("const", self.context)
         low, high = enclosure
         self.side_conditions += [fresh >= self.number(low), fresh <= self.number(high)]
+        self.constants[expr] = fresh
         return fresh
 
 

@@ -41,11 +41,23 @@ def describe_syntax_error(exc: UnexpectedInput, source: Source) -> Diagnostic:
     assert isinstance(exc, UnexpectedToken)
     token = exc.token
     span = _token_span(exc, source)
+    expected = _parser_expected(exc)
     for labeller in _LABELLERS:
-        message = labeller(token, set(exc.expected))
+        message = labeller(token, expected)
         if message:
             return error(message, span)
-    return error(_fallback(token, exc.expected), span)
+    return error(_fallback(token, expected), span)
+
+
+def _parser_expected(exc: UnexpectedToken) -> set[str]:
+    """The terminals the parser could take here. Errors found by the lexer report what
+    the lexer tried, which includes the always-lexed NAME and newline."""
+    state = exc.state
+    try:
+        return {name for name in state.parse_conf.states[state.position]
+                if name == name.upper()}  # terminals; rules are lower-case
+    except AttributeError:
+        return set(exc.expected)
 
 
 def _token_span(exc: UnexpectedToken, source: Source) -> Span:
@@ -114,7 +126,7 @@ def _time_domain(token, expected):
 
 
 def _open_needs_shape(token, expected):
-    if expected == {"BOX", "BALL", "ELLIPSOID"}:
+    if {"BOX", "BALL", "ELLIPSOID"} <= expected and "NAME" not in expected:
         return f"`open` must be followed by box, ball or ellipsoid, not {_shown(token)}"
     return None
 
@@ -147,8 +159,8 @@ def _stray_closer(token, expected):
 
 
 _LABELLERS = (_string_literal, _keyword_as_name, _unknown_statement, _time_domain,
-              _open_needs_shape, _missing_equals, _incomplete, _missing_comma,
-              _missing_operator, _stray_closer)
+              _open_needs_shape, _missing_equals, _incomplete, _missing_operator,
+              _missing_comma, _stray_closer)
 
 
 # ---- characters the lexer cannot read ---------------------------------------------

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import functools
+import re
 from importlib import resources
 from pathlib import Path
 
@@ -17,8 +18,8 @@ MAX_FILE_BYTES = 2_000_000
 MAX_NESTING = 100  # open brackets at once
 MAX_TREE_DEPTH = 400  # the checker walks trees recursively
 
-STATEMENT_KEYWORDS = ("SPEC", "STATE", "INPUT", "CONST", "DYNAMICS", "DOMAIN", "SET",
-                      "PROVE", "SYNTHESIS")
+STATEMENT_WORDS = ("spec", "state", "input", "const", "dynamics", "domain", "set", "prove",
+                   "synthesis")
 _CLOSERS = {"RPAR": "LPAR", "RSQB": "LSQB", "RBRACE": "LBRACE"}
 _NEWLINE_FREE = {"LPAR", "LSQB"}  # inside these, newlines do not end statements
 
@@ -36,27 +37,46 @@ def token_span(token: Token) -> Span:
 
 
 class BracketTracker(PostLex):
-    """Drops newlines inside ( ) and [ ]; reports unclosed and mismatched brackets."""
+    """Drops newlines inside ( ) and [ ]; reports unclosed and mismatched brackets.
 
-    always_accept = ("_NL",)
+    It also makes every reserved word a keyword token: the contextual lexer would
+    otherwise read `next` as a name where no keyword is expected.
+    """
+
+    # NAME everywhere, so that `states` is one name and never the keyword `state` + `s`.
+    always_accept = ("_NL", "NAME")
+
+    def __init__(self):
+        self.keywords: dict[str, str] = {}  # reserved word -> its terminal's name
+        self.opened: list[Token] = []
+        self.swallowed_newline = False  # the last newline was inside ( ) or [ ]
 
     def process(self, stream):
-        opened: list[Token] = []
-        after_newline = False
+        self.opened = opened = []
+        self.swallowed_newline = after_newline = False
         for token in stream:
             if token.type == "_NL":
                 after_newline = True
-                if opened and opened[-1].type in _NEWLINE_FREE:
-                    continue
-                yield token
+                self.swallowed_newline = bool(opened) and opened[-1].type in _NEWLINE_FREE
+                if not self.swallowed_newline:
+                    yield token
                 continue
-            if after_newline and opened and token.type in STATEMENT_KEYWORDS:
+            if token.type == "NAME" and token.value in self.keywords:
+                token = Token.new_borrow_pos(self.keywords[token.value], token.value, token)
+            if after_newline and opened and token.value in STATEMENT_WORDS:
                 raise BracketError(_unclosed(opened[-1]))
             after_newline = False
             self._track(token, opened)
             yield token
+            self.swallowed_newline = False
         if opened:
             raise BracketError(_unclosed(opened[-1]))
+
+    def unclosed_before(self, line: int):
+        """The unclosed bracket to blame for an error at `line` right after a newline."""
+        if self.swallowed_newline and self.opened and self.opened[-1].line < line:
+            return _unclosed(self.opened[-1])
+        return None
 
     @staticmethod
     def _track(token: Token, opened: list[Token]) -> None:
@@ -93,9 +113,13 @@ def _unclosed(token: Token):
 @functools.cache
 def _lark() -> Lark:
     grammar = resources.files("fossil_dsl.grammar").joinpath("fsl.lark").read_text("utf-8")
-    return Lark(grammar, parser="lalr", lexer="contextual", postlex=BracketTracker(),
-                propagate_positions=True, maybe_placeholders=True,
-                start=["start", "formula"])
+    parser = Lark(grammar, parser="lalr", lexer="contextual", postlex=BracketTracker(),
+                  propagate_positions=True, maybe_placeholders=True,
+                  start=["start", "formula"])
+    parser.options.postlex.keywords = {
+        t.pattern.value: t.name for t in parser.terminals
+        if t.pattern.type == "str" and re.fullmatch(r"[A-Za-z_]\w*", t.pattern.value)}
+    return parser
 
 
 def read_source(path: str | Path) -> Source:
@@ -138,10 +162,15 @@ def parse_source(source: Source) -> ast.SpecFile:
     except BracketError as exc:
         raise SpecSyntaxError([exc.diagnostic], source) from None
     except lark.exceptions.UnexpectedInput as exc:
-        raise SpecSyntaxError([describe_syntax_error(exc, source)], source) from None
+        raise SpecSyntaxError([_diagnose(exc, source)], source) from None
     _check_depth(tree, source)
     statements = ToAst().transform(tree)
     return ast.SpecFile(tuple(statements), source.path)
+
+
+def _diagnose(exc: lark.exceptions.UnexpectedInput, source: Source):
+    unclosed = _lark().options.postlex.unclosed_before(exc.line)
+    return unclosed or describe_syntax_error(exc, source)
 
 
 def parse(text: str, path: str = "<string>") -> ast.SpecFile:
