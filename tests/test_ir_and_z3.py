@@ -1,0 +1,164 @@
+"""The neutral expressions, their exact folding, printing and enclosures, and the Z3
+backend's verdicts on formulas with known answers."""
+from fractions import Fraction
+
+import mpmath
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from fossil_dsl import loads
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.enclosure import enclose, sign
+from fossil_dsl.ir.printing import number_text, to_text
+from fossil_dsl.smt.api import Status
+from fossil_dsl.smt.z3_backend import Z3Backend
+
+x, y = E.Var("x0"), E.Var("x1")
+
+
+def num(value) -> E.Num:
+    return E.Num(Fraction(value))
+
+
+# ---- exact folding ----------------------------------------------------------------
+def test_constants_fold_exactly():
+    assert E.add(num("0.1"), num("0.2")) == num("0.3")
+    assert E.power(num(2), num(-2)) == num("0.25")
+    assert E.mul(num(3), x, num(0)) == E.ZERO
+    assert E.apply("cos", E.ZERO) == E.ONE
+    assert E.apply("sqrt", num(Fraction(9, 4))) == num(Fraction(3, 2))
+    assert isinstance(E.apply("sqrt", num(2)), E.Apply)
+
+
+@pytest.mark.parametrize("build, message", [
+    (lambda: E.div(x, E.ZERO), "division by zero"),
+    (lambda: E.power(num(10), num(100_000)), "too large"),
+    (lambda: E.apply("log", num(-1)), "non-positive"),
+    (lambda: E.apply("sqrt", num(-1)), "negative"),
+])
+def test_impossible_constants_raise_expr_error(build, message):
+    with pytest.raises(E.ExprError, match=message):
+        build()
+
+
+def test_substitute_folds():
+    f = E.add(E.power(x, num(3)), E.mul(num(-1), y))
+    assert E.substitute(f, {"x0": num(2), "x1": num(3)}) == num(5)
+
+
+def test_theory_classification():
+    assert E.is_polynomial(x * y + x ** 3)
+    assert not E.is_polynomial(x / y)
+    assert E.is_arithmetic(x / y) and E.is_arithmetic(E.apply("abs", x))
+    assert not E.is_arithmetic(E.apply("sin", x))
+    assert not E.is_arithmetic(E.Pi() * x)
+
+
+# ---- printing ---------------------------------------------------------------------
+@pytest.mark.parametrize("value, text", [
+    (Fraction(1, 10), "0.1"), (Fraction(-3, 8), "-0.375"), (Fraction(1, 3), "1/3"),
+    (Fraction(7), "7"), (Fraction(981, 100), "9.81"),
+])
+def test_number_text_is_exact(value, text):
+    assert number_text(value) == text
+
+
+def test_expression_text():
+    assert to_text(x - y ** 2) == "x0 - x1^2"
+    assert to_text(-(x + y) * num(2)) == "-2*(x0 + x1)" or to_text(-(x + y) * num(2)) == "2*-(x0 + x1)"
+    assert to_text(E.apply("sin", x) / (x + 1)) == "sin(x0)/(x0 + 1)"
+
+
+leaves = st.one_of(st.sampled_from([x, y]),
+                   st.fractions(min_value=-20, max_value=20, max_denominator=50).map(E.Num))
+expressions = st.recursive(leaves, lambda inner: st.one_of(
+    st.tuples(inner, inner).map(lambda p: p[0] + p[1]),
+    st.tuples(inner, inner).map(lambda p: p[0] - p[1]),
+    st.tuples(inner, inner).map(lambda p: p[0] * p[1]),
+    st.tuples(inner, st.integers(0, 3)).map(lambda p: p[0] ** p[1]),
+    inner.map(lambda e: -e)), max_leaves=12)
+
+
+@settings(max_examples=150, deadline=None, derandomize=True, database=None)
+@given(expressions, st.fractions(-3, 3, max_denominator=7), st.fractions(-3, 3, max_denominator=7))
+def test_printed_expressions_parse_back_to_the_same_function(expr, a, b):
+    text = f"state x0, x1\ndynamics continuous {{\nx0' = {to_text(expr)}\nx1' = 0\n}}\n" \
+           "domain box([-1, -1], [1, 1])\nprove stable\n"
+    try:
+        spec = loads(text)
+    except Exception as exc:  # f(0) != 0 is a legitimate rejection for `stable`
+        assert "equilibrium" in str(exc), str(exc)
+        return
+    point = {"x0": E.Num(a), "x1": E.Num(b)}
+    assert E.substitute(spec.dynamics[0], point) == E.substitute(expr, point)
+
+
+# ---- enclosures ---------------------------------------------------------------------
+@settings(max_examples=100, deadline=None, derandomize=True, database=None)
+@given(st.sampled_from(["sin", "cos", "tan", "exp", "tanh", "atan", "abs", "sqrt", "log"]),
+       st.fractions(Fraction(1, 100), 5, max_denominator=1000))
+def test_enclosure_contains_the_true_value(func, value):
+    mpmath.mp.dps = 50
+    exact = getattr(mpmath, {"abs": "fabs"}.get(func, func))(mpmath.mpf(value.numerator) /
+                                                              value.denominator)
+    interval = enclose(E.Apply(func, E.Num(value)))
+    assert interval.lb() <= exact <= interval.ub()
+
+
+def test_sign_of_irrational_constants():
+    assert sign(E.Pi() - num("3.1415926535")) == 1
+    assert sign(E.apply("sqrt", num(2)) - num("1.4142135624")) == -1
+    assert sign(E.Apply("sin", E.Pi())) is None  # sin(pi) = 0 cannot be decided by intervals
+
+
+# ---- open inner approximation --------------------------------------------------------
+def test_open_inner_makes_comparisons_strict_and_flips_under_not():
+    closed = L.Compare("<=", x, E.ONE)
+    assert L.open_inner(closed) == L.Compare("<", x, E.ONE)
+    assert L.open_inner(L.negation(closed)) == L.Not(closed)
+    assert L.closed_outer(L.Compare("<", x, E.ONE)) == closed
+
+
+# ---- Z3 verdicts ----------------------------------------------------------------------
+def ball(r) -> L.Formula:
+    return L.Compare("<=", x ** 2 + y ** 2, num(r) ** 2)
+
+
+CONFORMANCE = [
+    ("empty", L.Compare("<", x ** 2 + y ** 2, E.ZERO), Status.UNSAT),
+    ("circle-meets-line", L.conjunction(ball(1), L.Compare(">=", x + y, num("1.4"))), Status.SAT),
+    ("circle-misses-line", L.conjunction(ball(1), L.Compare(">=", x + y, num("1.5"))), Status.UNSAT),
+    ("am-gm", L.Compare("<", x ** 2 + y ** 2, num(2) * x * y), Status.UNSAT),
+    ("cubic-root", L.conjunction(L.Compare("<=", x ** 3 - num(2), E.ZERO),
+                                 L.Compare(">=", x ** 3 - num(2), E.ZERO)), Status.SAT),
+    ("cubic-no-root", L.conjunction(L.Compare(">=", x ** 3 - num(2), E.ZERO),
+                                    L.Compare("<=", x, num("1.25"))), Status.UNSAT),
+    ("division", L.conjunction(L.Compare(">", x, E.ONE), L.Compare(">", E.ONE / x, E.ONE)),
+     Status.UNSAT),
+    ("abs", L.Compare("<", E.apply("abs", x), E.ZERO), Status.UNSAT),
+    ("pi-bounds", L.conjunction(L.Compare(">", x, E.Pi()), L.Compare("<", x, num("3.1415"))),
+     Status.UNSAT),
+]
+
+
+@pytest.mark.parametrize("formula, expected", [c[1:] for c in CONFORMANCE],
+                         ids=[c[0] for c in CONFORMANCE])
+def test_z3_conformance(formula, expected):
+    answer = Z3Backend().check(formula, ["x0", "x1"], timeout=10)
+    assert answer.status is expected
+    if expected is Status.SAT:
+        assert set(answer.model) == {"x0", "x1"}
+
+
+def test_z3_models_satisfy_the_formula_exactly():
+    formula = L.conjunction(ball(1), L.Compare(">=", x + y, num("1.4")))
+    answer = Z3Backend().check(formula, ["x0", "x1"], timeout=10)
+    point = {name: E.Num(value) for name, value in answer.model.items()}
+    assert E.substitute(x ** 2 + y ** 2, point).value <= 1
+    assert E.substitute(x + y, point).value >= Fraction("1.4")
+
+
+def test_z3_reports_transcendental_as_unknown_not_unsat():
+    answer = Z3Backend().check(L.Compare(">", E.apply("sin", x), num(2)), ["x0"], timeout=5)
+    assert answer.status is Status.UNKNOWN and "sin" in answer.reason
