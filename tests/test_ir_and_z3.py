@@ -162,3 +162,19 @@ def test_z3_models_satisfy_the_formula_exactly():
 def test_z3_reports_transcendental_as_unknown_not_unsat():
     answer = Z3Backend().check(L.Compare(">", E.apply("sin", x), num(2)), ["x0"], timeout=5)
     assert answer.status is Status.UNKNOWN and "sin" in answer.reason
+
+
+def test_like_terms_cancel_so_f0_is_exact():
+    two = num(2)
+    assert E.apply("sin", x + two) - E.apply("sin", two) != E.ZERO
+    assert E.substitute(E.apply("sin", x + two) - E.apply("sin", two), {"x0": E.ZERO}) == E.ZERO
+    assert x * num(3) - num(3) * x == E.ZERO
+    result = loads("state x0\ndynamics continuous { x0' = sin(x0 + 2) - sin(2) - x0 }\n"
+                   "domain ball([0], 1)\nprove stable\n")
+    assert result.dynamics[0] != E.ZERO
+
+
+def test_newlines_anywhere_inside_set_braces():
+    spec = loads("state x0, x1\ndynamics continuous {\n x0' = -x0\n x1' = -x1\n}\n"
+                 "domain {\n  x0 <= 1\n  , x1 <=\n    1, x0 >= -1, x1 >= -1\n}\nprove stable\n")
+    assert len(spec.domain.constraints) == 4

@@ -11,8 +11,8 @@ from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
 from fossil_dsl.check.options import OptionReader
 from fossil_dsl.check.properties import PropertyChecker, PropertyForm, formula_set_names
-from fossil_dsl.check.relations import RelationProver, SetLabel, check_equilibrium
-from fossil_dsl.check.sets import SetChecker
+from fossil_dsl.check.relations import RelationProver, Subject, check_equilibrium
+from fossil_dsl.check.sets import SetChecker, set_reference_names
 from fossil_dsl.diagnostics import Diagnostic, Span, article, has_errors
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import sets as S
@@ -211,6 +211,7 @@ class Checker:
         decl = self.singles.get("prove")
         if decl is not None:
             self.context.used.update(formula_set_names(decl.formula))
+            self.context.used.update(set_reference_names(decl.initial))
         if decl is None or sets.domain is None:
             return None
         return PropertyChecker(self.context, sets).check(decl)
@@ -231,29 +232,31 @@ class Checker:
         return options
 
     def prove_facts(self, form, prop, named, domain, dynamics, equation_spans, time) -> None:
-        prover = RelationProver(self.context, self.context.states, Z3Backend(), self.label)
-        prover.nonempty(domain)
-        for value in named.values():
-            prover.nonempty(value)
-        roles = prop.roles
+        prover = RelationProver(self.context, self.context.states, Z3Backend())
+        prover.nonempty(Subject(domain, "the domain", self.spans.get("domain")))
+        for name, value in named.items():
+            prover.nonempty(self.subject(value))
+        subjects = {role: self.subject(value, role) for role, value in prop.roles.items()}
         for kind, first, second in form.relations:
-            prover.prove(kind, roles[first], roles[second])
+            prover.prove(kind, subjects[first], subjects[second])
         if self.context.inputs:
             for role in form.origin_roles:
-                prover.contains_origin(roles[role])
+                prover.contains_origin(subjects[role])
         if form.stable_type:
             check_equilibrium(self.context, self.context.states, self.context.inputs,
                               dynamics, equation_spans, time is TimeDomain.DISCRETE)
 
-    def label(self, value: S.SetExpr) -> SetLabel:
+    def subject(self, value: S.SetExpr, role: str = "") -> Subject:
+        """A set named for messages: by its name, or by its role in the property."""
         if isinstance(value, S.Named):
-            return SetLabel(f"`{value.name}`", self.context.names[value.name].ident.span)
-        if isinstance(value, S.Complement) and isinstance(value.operand, S.Named):
-            return SetLabel(f"the safe set (the domain minus `{value.operand.name}`)",
-                            self.spans.get("prove"))
+            return Subject(value, f"`{value.name}`", self.context.names[value.name].ident.span)
         if value is self.domain:
-            return SetLabel("the domain", self.spans.get("domain"))
-        return SetLabel(f"the set {value.text()}", self.spans.get("prove"))
+            return Subject(value, "the domain", self.spans.get("domain"))
+        derived = _DERIVED.get((role, type(value)))
+        if derived and isinstance(_given(value), S.Named):
+            name = _given(value).name
+            return Subject(value, derived.format(name), self.context.names[name].ident.span)
+        return Subject(value, f"the {role or 'set'} {value.text()}", self.spans.get("prove"))
 
     def warn_unused(self) -> None:
         for name, declared in self.context.names.items():
@@ -272,6 +275,18 @@ class Checker:
             constants=MappingProxyType(dict(self.context.constants)), time=time,
             dynamics=dynamics, domain=domain, sets=MappingProxyType(named),
             property=prop, synthesis=options, spans=MappingProxyType(self.spans))
+
+
+# How a role's set reads when the property derived it from a declared set.
+_DERIVED = {
+    ("safe", S.Complement): "the safe set (the domain minus `{}`)",
+    ("unsafe", S.Complement): "the unsafe set (the domain minus `{}`)",
+    ("safe", S.Intersection): "the safe set `{}` (within the domain)",
+}
+
+
+def _given(value: S.SetExpr) -> S.SetExpr:
+    return value.operand if isinstance(value, S.Complement) else value.left
 
 
 _REQUIRED_HELP = {

@@ -246,7 +246,7 @@ def _letter_roles(letter, value, negated, domain) -> dict:
         return {"unsafe": None}
     if negated:
         return {"unsafe": value, "safe": S.Complement(value, domain)}
-    return {"safe": value, "unsafe": S.Complement(value, domain)}
+    return {"safe": S.Intersection(value, domain), "unsafe": S.Complement(value, domain)}
 
 
 def formula_set_names(formula: ast.Formula) -> set[str]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Callable, Sequence
+from typing import Sequence
 
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.diagnostics import Span
@@ -31,22 +31,25 @@ def _coordinate(value: Fraction) -> str:
     return text if len(text) <= 12 and "/" not in text else format(float(value), ".6g")
 
 
-@dataclass
-class SetLabel:
-    """How a set is named in messages, and where it is reported."""
+@dataclass(frozen=True)
+class Subject:
+    """A set with the words that name it in messages and the place it is reported at."""
 
+    value: S.SetExpr
     text: str
     span: Span | None
 
 
 class RelationProver:
     def __init__(self, context: CheckContext, states: Sequence[str], backend: Backend,
-                 label: Callable[[S.SetExpr], SetLabel], timeout: float = RELATION_TIMEOUT):
+                 timeout: float = RELATION_TIMEOUT):
         self.context = context
         self.states = tuple(states)
         self.backend = backend
-        self.label = label
         self.timeout = timeout
+
+    def _member(self, subject: Subject) -> L.Formula:
+        return subject.value.contains_formula(self.states)
 
     def _query(self, formula: L.Formula, claim: str, span: Span | None):
         """A witness if `formula` is satisfiable; None if UNSAT or undecided (warned)."""
@@ -60,60 +63,45 @@ class RelationProver:
         self.context.warning(f"could not prove that {claim} ({self.backend.name}: {why})", span)
         return None
 
-    def inside(self, inner: S.SetExpr, outer: S.SetExpr) -> None:
-        a, b = self.label(inner), self.label(outer)
-        query = L.conjunction(inner.contains_formula(self.states),
-                              L.negation(outer.contains_formula(self.states)))
+    def inside(self, a: Subject, b: Subject) -> None:
+        query = L.conjunction(self._member(a), L.negation(self._member(b)))
         witness = self._query(query, f"{a.text} is inside {b.text}", a.span)
         if witness is not None:
             self.context.error(f"{a.text} is not inside {b.text}: {point_text(witness)} is "
                                f"in {a.text} but not in {b.text}", a.span)
 
-    def inside_interior(self, inner: S.SetExpr, outer: S.SetExpr) -> None:
-        a, b = self.label(inner), self.label(outer)
-        interior = L.open_inner(outer.contains_formula(self.states))
-        query = L.conjunction(inner.contains_formula(self.states), L.negation(interior))
-        claim = f"{a.text} is inside the interior of {b.text}"
-        witness = self._query(query, claim, a.span)
+    def inside_interior(self, a: Subject, b: Subject) -> None:
+        interior = L.open_inner(self._member(b))
+        query = L.conjunction(self._member(a), L.negation(interior))
+        witness = self._query(query, f"{a.text} is inside the interior of {b.text}", a.span)
         if witness is not None:
             self.context.error(f"{a.text} is not inside the interior of {b.text}: "
                                f"{point_text(witness)} is in {a.text} but on the boundary "
                                "or outside", a.span)
 
-    def disjoint(self, first: S.SetExpr, second: S.SetExpr) -> None:
-        a, b = self.label(first), self.label(second)
-        query = L.conjunction(first.contains_formula(self.states),
-                              second.contains_formula(self.states))
+    def disjoint(self, a: Subject, b: Subject) -> None:
+        query = L.conjunction(self._member(a), self._member(b))
         witness = self._query(query, f"{a.text} and {b.text} are disjoint", a.span)
         if witness is not None:
             self.context.error(f"{a.text} and {b.text} overlap: {point_text(witness)} is "
                                "in both", a.span)
 
-    def contains_origin(self, region: S.SetExpr) -> None:
-        a = self.label(region)
+    def contains_origin(self, a: Subject) -> None:
         origin = [E.ZERO] * len(self.states)
-        query = L.negation(region.membership(origin))
+        query = L.negation(a.value.membership(origin))
         if self._query(query, f"{a.text} contains the origin", a.span) is not None:
             self.context.error(f"{a.text} does not contain the origin, the equilibrium that "
                                "the controller (with k(0) = 0) keeps", a.span)
 
-    def nonempty(self, region: S.SetExpr) -> None:
-        a = self.label(region)
-        answer = self.backend.check(region.contains_formula(self.states), self.states,
-                                    self.timeout)
+    def nonempty(self, a: Subject) -> None:
+        answer = self.backend.check(self._member(a), self.states, self.timeout)
         if answer.status is Status.UNSAT:
             self.context.error(f"{a.text} is empty: no point satisfies its description",
                                a.span)
 
-    def prove(self, kind: str, first: S.SetExpr, second: S.SetExpr | None) -> None:
-        if kind == "inside":
-            self.inside(first, second)
-        elif kind == "inside_interior":
-            self.inside_interior(first, second)
-        elif kind == "disjoint":
-            self.disjoint(first, second)
-        else:
-            raise ValueError(f"unknown relation {kind}")
+    def prove(self, kind: str, a: Subject, b: Subject) -> None:
+        {"inside": self.inside, "inside_interior": self.inside_interior,
+         "disjoint": self.disjoint}[kind](a, b)
 
 
 def check_equilibrium(context: CheckContext, states: Sequence[str], inputs: Sequence[str],

@@ -128,6 +128,19 @@ class SetChecker:
         return tuple(self.parameters.convert(item) for item in node.items)
 
 
+def set_reference_names(node: ast.SetExpr | None) -> set[str]:
+    names, stack = set(), [node] if node is not None else []
+    while stack:
+        item = stack.pop()
+        if isinstance(item, ast.SetRef):
+            names.add(item.name)
+        elif isinstance(item, ast.SetBinary):
+            stack.extend((item.left, item.right))
+        elif isinstance(item, ast.SetComplement):
+            stack.append(item.operand)
+    return names
+
+
 def _argument_span(arg, component: int | None) -> Span:
     if component is not None and isinstance(arg, ast.Vector):
         return arg.items[component].span

@@ -115,17 +115,30 @@ def is_num(expr: Expr, value=None) -> bool:
 
 # ---- smart constructors (exact folding of rational constants) -----------------------
 def add(*terms: Expr) -> Expr:
-    flat: list[Expr] = []
+    """A sum with its constants folded and like terms collected (c*t + d*t = (c+d)*t)."""
+    coefficients: dict[Expr, Fraction] = {}
     constant = Fraction(0)
     for term in terms:
         for part in (term.terms if isinstance(term, Add) else (term,)):
             if isinstance(part, Num):
                 constant += part.value
             else:
-                flat.append(part)
+                base, factor = _split_coefficient(part)
+                coefficients[base] = coefficients.get(base, Fraction(0)) + factor
+    flat = [mul(Num(c), base) for base, c in coefficients.items() if c != 0]
     if constant != 0 or not flat:
         flat.append(_checked(constant))
     return flat[0] if len(flat) == 1 else Add(tuple(flat))
+
+
+def _split_coefficient(term: Expr) -> tuple[Expr, Fraction]:
+    if isinstance(term, Neg):
+        base, factor = _split_coefficient(term.operand)
+        return base, -factor
+    if isinstance(term, Mul) and isinstance(term.factors[0], Num):
+        rest = term.factors[1:]
+        return (rest[0] if len(rest) == 1 else Mul(rest)), term.factors[0].value
+    return term, Fraction(1)
 
 
 def mul(*factors: Expr) -> Expr:

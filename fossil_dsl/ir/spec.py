@@ -62,8 +62,9 @@ class SynthesisOptions:
 class Property:
     """A normalised property: its form (from the reference's table) and its sets by role.
 
-    Roles: initial, unsafe, safe, goal, final (whichever the form uses); `safe` is the
-    domain minus `unsafe` wherever the form avoids something.
+    Roles: domain, initial, unsafe, safe, goal, final (whichever the form uses). Where
+    the form avoids something, `safe` is the domain minus `unsafe` (for `not U`) or the
+    given safe set within the domain (for `S`, with `unsafe` the domain minus S).
     """
 
     form: str

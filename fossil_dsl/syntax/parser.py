@@ -21,7 +21,9 @@ MAX_TREE_DEPTH = 400  # the checker walks trees recursively
 STATEMENT_WORDS = ("spec", "state", "input", "const", "dynamics", "domain", "set", "prove",
                    "synthesis")
 _CLOSERS = {"RPAR": "LPAR", "RSQB": "LSQB", "RBRACE": "LBRACE"}
-_NEWLINE_FREE = {"LPAR", "LSQB"}  # inside these, newlines do not end statements
+# A `{` after these opens a block, where newlines separate lines; any other `{` is a
+# set { C1, C2 } and, like ( ) and [ ], ignores newlines.
+_BLOCK_OPENERS = {"CONTINUOUS", "DISCRETE", "SYNTHESIS"}
 
 
 class BracketError(Exception):
@@ -49,45 +51,52 @@ class BracketTracker(PostLex):
     def __init__(self):
         self.keywords: dict[str, str] = {}  # reserved word -> its terminal's name
         self.opened: list[Token] = []
-        self.swallowed_newline = False  # the last newline was inside ( ) or [ ]
+        self.newline_free: list[bool] = []  # for each open bracket
+        self.swallowed_newline = False  # the last newline was inside ( ), [ ] or a set
 
     def process(self, stream):
-        self.opened = opened = []
+        self.opened, self.newline_free = [], []
         self.swallowed_newline = after_newline = False
+        previous = None
         for token in stream:
             if token.type == "_NL":
                 after_newline = True
-                self.swallowed_newline = bool(opened) and opened[-1].type in _NEWLINE_FREE
+                self.swallowed_newline = bool(self.newline_free) and self.newline_free[-1]
                 if not self.swallowed_newline:
                     yield token
                 continue
             if token.type == "NAME" and token.value in self.keywords:
                 token = Token.new_borrow_pos(self.keywords[token.value], token.value, token)
-            if after_newline and opened and token.value in STATEMENT_WORDS:
-                raise BracketError(_unclosed(opened[-1]))
+            if after_newline and self.opened and token.value in STATEMENT_WORDS:
+                raise BracketError(_unclosed(self.opened[-1]))
             after_newline = False
-            self._track(token, opened)
+            self._track(token, previous)
+            previous = token
             yield token
             self.swallowed_newline = False
-        if opened:
-            raise BracketError(_unclosed(opened[-1]))
+        if self.opened:
+            raise BracketError(_unclosed(self.opened[-1]))
 
     def unclosed_before(self, line: int):
-        """The unclosed bracket to blame for an error at `line` right after a newline."""
+        """The unclosed bracket to blame for an error at `line`, right after a newline
+        that the bracket swallowed."""
         if self.swallowed_newline and self.opened and self.opened[-1].line < line:
             return _unclosed(self.opened[-1])
         return None
 
-    @staticmethod
-    def _track(token: Token, opened: list[Token]) -> None:
+    def _track(self, token: Token, previous: Token | None) -> None:
         if token.type in ("LPAR", "LSQB", "LBRACE"):
-            if len(opened) >= MAX_NESTING:
+            if len(self.opened) >= MAX_NESTING:
                 raise BracketError(error(
                     f"brackets nested too deeply (more than {MAX_NESTING} levels)",
                     token_span(token)))
-            opened.append(token)
+            self.opened.append(token)
+            block = token.type == "LBRACE" and previous is not None \
+                and previous.type in _BLOCK_OPENERS
+            self.newline_free.append(not block)
         elif token.type in _CLOSERS:
-            _close(token, opened)
+            _close(token, self.opened)
+            self.newline_free.pop()
 
 
 def _close(token: Token, opened: list[Token]) -> None:
