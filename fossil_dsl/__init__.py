@@ -4,14 +4,15 @@
     import fossil_dsl
     spec = fossil_dsl.load("specs/paper_lyapunov.fsl")     # a CheckedSpec
     result = fossil_dsl.check_file("spec.fsl")             # diagnostics as objects
+    outcome = fossil_dsl.synthesise(spec, seed=1)          # learn and prove
 """
 from fossil_dsl.api import (CheckResult, check_file, check_source, check_text, load, loads,
-                            parse)
+                            parse, synthesise)
 from fossil_dsl.diagnostics import Diagnostic, FslError, Severity, SpecError, SpecSyntaxError
 from fossil_dsl.ir.spec import CheckedSpec
 
-__version__ = "0.1.0"
+from fossil_dsl.version import __version__
 
 __all__ = ["CheckResult", "CheckedSpec", "Diagnostic", "FslError", "Severity", "SpecError",
            "SpecSyntaxError", "check_file", "check_source", "check_text", "load", "loads",
-           "parse", "__version__"]
+           "parse", "synthesise", "__version__"]

@@ -1,10 +1,15 @@
 """The Python interface; the `fossilc` command is a thin layer over these functions."""
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from fossil_dsl.cegis.loop import Cegis
 from fossil_dsl.check.checker import check as _check_tree
+from fossil_dsl.plan import compile_spec
+from fossil_dsl.result import Result, build_result
+from fossil_dsl.smt import registry
 from fossil_dsl.diagnostics import Diagnostic, Source, SpecError, has_errors, render_all
 from fossil_dsl.ir.spec import CheckedSpec
 from fossil_dsl.syntax import ast
@@ -62,6 +67,16 @@ def check_file(path: str | Path) -> CheckResult:
     except SpecError as exc:
         return CheckResult(exc.source or Source(str(path), ""), None, tuple(exc.diagnostics))
     return check_source(source)
+
+
+def synthesise(spec: CheckedSpec, progress=None, **options) -> Result:
+    """Compile a checked spec and run CEGIS. `options` override the synthesis block:
+    verifier, seed, max_iters, timeout, learning_rate, margin, digits, query_timeout."""
+    started = time.monotonic()
+    plan = compile_spec(spec, **options)
+    backend = registry.load(plan.verifier)
+    outcome = Cegis(plan, backend, progress).run()
+    return build_result(plan, outcome, time.monotonic() - started)
 
 
 def _checked(result: CheckResult) -> CheckedSpec:

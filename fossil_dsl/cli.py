@@ -2,18 +2,23 @@
 
     fossilc SPEC.fsl            check, compile and synthesise (exit 0 / 1 / 2)
     fossilc check SPEC...       the static checks only (exit 0 / 2)
+    fossilc compile SPEC        the certificate plan, its SMT-LIB queries or its losses
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from typing import Sequence
 
 from rich.console import Console
 
-from fossil_dsl import __version__
-from fossil_dsl.api import CheckResult, check_file
+from fossil_dsl.version import __version__
+from fossil_dsl.api import CheckResult, check_file, synthesise
+from fossil_dsl.plan import CompileError, compile_spec, loss_text, plan_text, symbolic_queries
+from fossil_dsl.result import summary_text, write_artefacts
+from fossil_dsl.smt.registry import BackendUnavailable
 
 EXIT_OK, EXIT_NOT_CERTIFIED, EXIT_BAD_SPEC, EXIT_INTERNAL = 0, 1, 2, 3
 
@@ -23,13 +28,14 @@ def _consoles() -> tuple[Console, Console]:
         Console(stderr=True, highlight=False, soft_wrap=True)
 
 
-def _report(result: CheckResult, out: Console, err: Console, quiet: bool) -> None:
+def _report(result: CheckResult, out: Console, err: Console, quiet: bool,
+            summary: bool = True) -> None:
     for diagnostic in result.diagnostics:
         if quiet and not diagnostic.is_error:
             continue
         style = "red" if diagnostic.is_error else "yellow"
         err.print(diagnostic.render(result.source), style=style, markup=False)
-    if result.ok:
+    if result.ok and summary:
         out.print(f"ok: {result.source.path}: {result.spec.summary()}", markup=False)
 
 
@@ -44,23 +50,86 @@ def command_check(args: argparse.Namespace) -> int:
 def command_run(args: argparse.Namespace) -> int:
     out, err = _consoles()
     result = check_file(args.spec)
-    _report(result, out, err, args.quiet)
+    _report(result, out, err, args.quiet or args.json, summary=not args.json)
     if not result.ok:
         return EXIT_BAD_SPEC
-    err.print("fossilc: synthesis is not available yet in this version: the spec was "
-              "checked, nothing was learned or proved", markup=False)
-    return EXIT_BAD_SPEC
+    progress = None if (args.quiet or args.json) else _progress_printer(err)
+    overrides = {"verifier": args.verifier, "seed": args.seed, "max_iters": args.max_iters,
+                 "timeout": args.timeout}
+    try:
+        outcome = synthesise(result.spec, progress=progress, **overrides)
+    except (CompileError, BackendUnavailable) as exc:
+        err.print(f"{args.spec}: error: {exc}", style="red", markup=False)
+        return EXIT_BAD_SPEC
+    if args.output:
+        write_artefacts(outcome, args.output)
+    if args.json:
+        print(json.dumps(outcome.to_json(), indent=2))
+    else:
+        style = "bold green" if outcome.certified else "bold red"
+        out.print(summary_text(outcome), style=style if args.quiet else None, markup=False)
+    return outcome.exit_code
+
+
+def _progress_printer(err: Console):
+    def show(record) -> None:
+        failed = ", ".join(record.failed) or "none"
+        err.print(f"  iteration {record.iteration:3d}  loss {record.loss:10.3g}  "
+                  f"failed: {failed:<24}  learn {record.learn_seconds:6.2f} s  "
+                  f"verify {record.verify_seconds:6.2f} s", markup=False, style="dim")
+    return show
+
+
+def command_compile(args: argparse.Namespace) -> int:
+    out, err = _consoles()
+    result = check_file(args.spec)
+    _report(result, out, err, quiet=True)
+    if not result.ok:
+        return EXIT_BAD_SPEC
+    try:
+        plan = compile_spec(result.spec, verifier=args.verifier)
+    except (CompileError, BackendUnavailable) as exc:
+        err.print(f"{args.spec}: error: {exc}", style="red", markup=False)
+        return EXIT_BAD_SPEC
+    if args.emit == "plan" or args.explain:
+        out.print(plan_text(plan), markup=False)
+    if args.emit == "smt2":
+        for name, script in symbolic_queries(plan).items():
+            out.print(script, markup=False)
+    if args.emit == "losses":
+        out.print(loss_text(plan), markup=False)
+    return EXIT_OK
 
 
 def _run_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="fossilc", description="Check a .fsl spec, learn a certificate (and a "
         "controller) and prove it.",
-        epilog="other commands: `fossilc check SPEC...` (run `fossilc check --help`)")
+        epilog="other commands: `fossilc check SPEC...`, `fossilc compile SPEC --emit "
+        "plan|smt2|losses` (each has --help)")
     parser.add_argument("spec", help="the .fsl file")
-    parser.add_argument("-q", "--quiet", action="store_true", help="errors only")
+    parser.add_argument("-o", "--output", metavar="DIR",
+                        help="write result.json, certificate.txt and obligations/*.smt2")
+    parser.add_argument("--verifier", help="z3, cvc5, dreal or interval")
+    parser.add_argument("--seed", type=int, help="random seed (the same seed, the same run)")
+    parser.add_argument("--max-iters", type=int, help="CEGIS iterations before giving up")
+    parser.add_argument("--timeout", type=float, help="seconds for the whole run")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress, errors only")
+    parser.add_argument("--json", action="store_true", help="print result.json on stdout")
     parser.add_argument("--version", action="version", version=f"fossilc {__version__}")
     parser.set_defaults(handler=command_run)
+    return parser
+
+
+def _compile_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="fossilc compile",
+                                     description="Show the certificate plan of a spec.")
+    parser.add_argument("spec", help="the .fsl file")
+    parser.add_argument("--emit", choices=["plan", "smt2", "losses"], default="plan")
+    parser.add_argument("--explain", action="store_true",
+                        help="also print the plan and the guarantee in words")
+    parser.add_argument("--verifier", help="z3, cvc5, dreal or interval")
+    parser.set_defaults(handler=command_compile)
     return parser
 
 
@@ -73,7 +142,7 @@ def _check_parser() -> argparse.ArgumentParser:
     return parser
 
 
-COMMANDS = {"check": _check_parser}
+COMMANDS = {"check": _check_parser, "compile": _compile_parser}
 
 
 def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:

@@ -8,13 +8,19 @@ PACKAGE = Path(__file__).resolve().parent.parent / "fossil_dsl"
 
 # What each part of the package may import from the package (besides itself).
 ALLOWED = {
+    "version": set(),
     "diagnostics": set(),
     "ir": {"diagnostics"},
     "syntax": {"diagnostics"},
     "smt": {"diagnostics", "ir"},
     "check": {"diagnostics", "ir", "syntax", "smt"},
-    "api": {"diagnostics", "ir", "syntax", "check"},
-    "cli": {"diagnostics", "api", "__init__"},
+    "certificates": {"diagnostics", "ir"},
+    "plan": {"diagnostics", "ir", "certificates", "smt"},
+    "learn": {"ir"},
+    "cegis": {"ir", "certificates", "learn", "plan", "smt"},
+    "result": {"version", "ir", "plan", "cegis", "smt"},
+    "api": {"diagnostics", "ir", "syntax", "check", "plan", "cegis", "result", "smt"},
+    "cli": {"version", "diagnostics", "api", "plan", "result", "smt"},
 }
 
 

@@ -82,12 +82,33 @@ def test_warnings_print_but_exit_0(tmp_path):
     assert quiet.returncode == 0 and "warning" not in quiet.stderr
 
 
-def test_run_says_synthesis_is_not_available_yet(tmp_path):
-    run = fossilc(write(tmp_path, GOOD))
-    assert run.returncode == 2
-    assert "synthesis is not available yet" in run.stderr
-    assert "stability (Lyapunov)" in run.stdout
+CERTIFIABLE = GOOD.replace("x1 - x0^3", "-x0 + x0*x1").replace("-x0\n}", "-x1\n}")
+
+
+def test_run_certifies_and_exits_0(tmp_path):
+    run = fossilc(write(tmp_path, CERTIFIABLE), "--seed", "1")
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "CERTIFIED (stability, Lyapunov function)" in run.stdout
+    assert "V(x) = " in run.stdout and "guarantee: the origin is asymptotically stable" in run.stdout
+    assert "iteration   1" in run.stderr  # progress
     assert_no_traceback(run)
+
+
+def test_run_not_certified_exits_1(tmp_path):
+    unstable = CERTIFIABLE.replace("-x0 + x0*x1", "x0 + x1")
+    run = fossilc(write(tmp_path, unstable), "--max-iters", "2", "--quiet")
+    assert run.returncode == 1
+    assert "NOT CERTIFIED" in run.stdout and "nothing is proved" in run.stdout
+    assert "iteration" not in run.stderr
+    assert_no_traceback(run)
+
+
+def test_run_json_is_pure_json(tmp_path):
+    import json
+    run = fossilc(write(tmp_path, CERTIFIABLE), "--json")
+    data = json.loads(run.stdout)
+    assert data["verdict"] == "certified" and data["schema"] == 1
+    assert set(data["functions"]) == {"V"}
 
 
 def test_run_on_bad_spec_exits_2(tmp_path):

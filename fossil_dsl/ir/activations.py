@@ -1,11 +1,21 @@
 """The activation functions a network layer may use, by name.
 
-The learner and the solvers attach their own implementations to these names; the
-checker only needs to know which names exist and which are polynomial.
+Each activation has two faces in one place: `symbolic` builds its exact neutral
+expression (for the verifier) and `tensor` applies it to a batch (for the learner).
+A new activation is one entry in ACTIVATIONS.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
+from typing import Callable
+
+from fossil_dsl.ir import expr as E
+
+
+def _chunk_power(index: int, width: int, degree: int) -> int:
+    """polyN splits a layer's neurons into N chunks with powers 1..N."""
+    return 1 + (index * degree) // width
 
 
 @dataclass(frozen=True)
@@ -13,17 +23,45 @@ class Activation:
     name: str
     polynomial_degree: int | None  # None: not a polynomial
     zero_at_zero: bool
+    symbolic: Callable[[E.Expr, int, int], E.Expr]  # (pre-activation, neuron, width)
+    tensor: Callable  # (batch, width) tensor -> same shape
+
+    def apply(self, z: E.Expr, index: int, width: int) -> E.Expr:
+        return self.symbolic(z, index, width)
+
+
+def _power(n: int) -> Activation:
+    name = {1: "linear", 2: "square", 3: "cube"}[n]
+    return Activation(name, n, True, lambda z, i, w: E.power(z, E.Num(n)),
+                      lambda t: t if n == 1 else t ** n)
+
+
+def _poly(degree: int) -> Activation:
+    def tensor(t):
+        import torch
+        width = t.shape[-1]
+        powers = torch.tensor([_chunk_power(i, width, degree) for i in range(width)],
+                              dtype=t.dtype)
+        return t ** powers
+
+    return Activation(f"poly{degree}", degree, True,
+                      lambda z, i, w: E.power(z, E.Num(_chunk_power(i, w, degree))), tensor)
+
+
+def _softplus(t):
+    import torch.nn.functional as F
+    return F.softplus(t)
 
 
 ACTIVATIONS: dict[str, Activation] = {a.name: a for a in (
-    Activation("linear", 1, True),
-    Activation("square", 2, True),
-    Activation("cube", 3, True),
-    Activation("poly2", 2, True),
-    Activation("poly3", 3, True),
-    Activation("poly4", 4, True),
-    Activation("relu", None, True),
-    Activation("sigmoid", None, False),
-    Activation("tanh", None, True),
-    Activation("softplus", None, False),
+    _power(1), _power(2), _power(3), _poly(2), _poly(3), _poly(4),
+    Activation("relu", None, True,
+               lambda z, i, w: E.mul(E.Num(Fraction(1, 2)), E.add(z, E.apply("abs", z))),
+               lambda t: t.relu()),
+    Activation("sigmoid", None, False,
+               lambda z, i, w: E.div(E.ONE, E.add(E.ONE, E.apply("exp", E.neg(z)))),
+               lambda t: t.sigmoid()),
+    Activation("tanh", None, True, lambda z, i, w: E.apply("tanh", z), lambda t: t.tanh()),
+    Activation("softplus", None, False,
+               lambda z, i, w: E.apply("log", E.add(E.ONE, E.apply("exp", z))), _softplus),
 )}

@@ -64,6 +64,10 @@ def _sum_text(terms) -> str:
             parts.append(" - " + _wrap(term.operand, _PRODUCT))
         elif isinstance(term, E.Num) and term.value < 0:
             parts.append(" - " + number_text(-term.value))
+        elif isinstance(term, E.Mul) and isinstance(term.factors[0], E.Num) \
+                and term.factors[0].value < 0:
+            parts.append(" - " + _wrap(E.mul(E.Num(-term.factors[0].value),
+                                             *term.factors[1:]), _PRODUCT))
         else:
             parts.append(" + " + _wrap(term, _PRODUCT))
     return "".join(parts)

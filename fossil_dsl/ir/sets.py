@@ -10,16 +10,43 @@ from dataclasses import dataclass
 from typing import ClassVar, Sequence
 
 from fossil_dsl.ir import logic as L
-from fossil_dsl.ir.enclosure import sign
+from fossil_dsl.ir.enclosure import enclose, sign
 from fossil_dsl.ir.expr import Expr, Var, add, mul, power, div, Num
 from fossil_dsl.ir.printing import to_text
 
 Point = Sequence[Expr]
 
 
+Bounds = tuple[tuple[float, ...], tuple[float, ...]]
+
+
+def _low(value: Expr) -> float:
+    return enclose(value).lb()
+
+
+def _high(value: Expr) -> float:
+    return enclose(value).ub()
+
+
+def _hull(a: Bounds | None, b: Bounds | None) -> Bounds | None:
+    if a is None or b is None:
+        return None
+    return (tuple(map(min, a[0], b[0])), tuple(map(max, a[1], b[1])))
+
+
+def _meet(a: Bounds | None, b: Bounds | None) -> Bounds | None:
+    if a is None or b is None:
+        return a or b
+    return (tuple(map(max, a[0], b[0])), tuple(map(min, a[1], b[1])))
+
+
 class SetExpr:
     def membership(self, point: Point) -> L.Formula:
         raise NotImplementedError
+
+    def bounding_box(self) -> Bounds | None:
+        """A box containing the set (for sampling), or None if the set does not say."""
+        return None
 
     def contains_formula(self, states: Sequence[str]) -> L.Formula:
         return self.membership([Var(name) for name in states])
@@ -77,6 +104,9 @@ class Box(Shape):
                                     f"upper bound {to_text(hi)} in coordinate {i + 1}"))
         return found
 
+    def bounding_box(self):
+        return tuple(map(_low, self.lower)), tuple(map(_high, self.upper))
+
     def membership(self, point):
         rel = _le(self.is_open)
         return L.conjunction(*(
@@ -117,6 +147,10 @@ class Ball(Shape):
     def problems(self):
         return _positive_problems([self.radius], 1, "the radius", vector=False)
 
+    def bounding_box(self):
+        r = _high(self.radius)
+        return (tuple(_low(c) - r for c in self.centre), tuple(_high(c) + r for c in self.centre))
+
     def membership(self, point):
         return L.Compare(_le(self.is_open), _squared_distance(point, self.centre),
                          power(self.radius, Num(2)))
@@ -135,6 +169,10 @@ class Ellipsoid(Shape):
 
     def problems(self):
         return _positive_problems(self.semi_axes, 1, "a semi-axis", vector=True)
+
+    def bounding_box(self):
+        return (tuple(_low(c) - _high(a) for c, a in zip(self.centre, self.semi_axes)),
+                tuple(_high(c) + _high(a) for c, a in zip(self.centre, self.semi_axes)))
 
     def membership(self, point):
         return L.Compare(_le(self.is_open),
@@ -168,6 +206,9 @@ class Union(SetExpr):
     left: SetExpr
     right: SetExpr
 
+    def bounding_box(self):
+        return _hull(self.left.bounding_box(), self.right.bounding_box())
+
     def membership(self, point):
         return L.disjunction(self.left.membership(point), self.right.membership(point))
 
@@ -180,6 +221,9 @@ class Intersection(SetExpr):
     left: SetExpr
     right: SetExpr
 
+    def bounding_box(self):
+        return _meet(self.left.bounding_box(), self.right.bounding_box())
+
     def membership(self, point):
         return L.conjunction(self.left.membership(point), self.right.membership(point))
 
@@ -191,6 +235,9 @@ class Intersection(SetExpr):
 class Difference(SetExpr):
     left: SetExpr
     right: SetExpr
+
+    def bounding_box(self):
+        return self.left.bounding_box()
 
     def membership(self, point):
         return L.conjunction(self.left.membership(point),
@@ -207,6 +254,9 @@ class Complement(SetExpr):
     operand: SetExpr
     domain: SetExpr
 
+    def bounding_box(self):
+        return self.domain.bounding_box()
+
     def membership(self, point):
         return L.conjunction(self.domain.membership(point),
                              L.negation(self.operand.membership(point)))
@@ -221,6 +271,9 @@ class Named(SetExpr):
 
     name: str
     value: SetExpr
+
+    def bounding_box(self):
+        return self.value.bounding_box()
 
     def membership(self, point):
         return self.value.membership(point)

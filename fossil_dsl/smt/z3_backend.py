@@ -94,6 +94,9 @@ class Z3Converter:
 class Z3Backend:
     name = "z3"
 
+    def check_text(self, text: str, timeout: float, variables=()) -> Answer:
+        return check_smtlib(text, timeout)
+
     def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
         context = z3.Context()
         converter = Z3Converter(context)
@@ -112,6 +115,20 @@ class Z3Backend:
             model = _model(solver.model(), [converter.var(v) for v in variables])
             return Answer(Status.SAT, dict(zip(variables, model)), approximate=approximate)
         return Answer(Status.UNKNOWN, reason=solver.reason_unknown(), approximate=approximate)
+
+
+def check_smtlib(text: str, timeout: float) -> Answer:
+    """Decide an SMT-LIB 2 script (as exported next to a result)."""
+    context = z3.Context()
+    solver = z3.Solver(ctx=context)
+    solver.set("timeout", max(1, int(timeout * 1000)))
+    solver.from_string(text)
+    result = solver.check()
+    if result == z3.unsat:
+        return Answer(Status.UNSAT)
+    if result == z3.sat:
+        return Answer(Status.SAT)
+    return Answer(Status.UNKNOWN, reason=solver.reason_unknown())
 
 
 def _model(model: z3.ModelRef, variables) -> list[Fraction]:

@@ -1,0 +1,111 @@
+"""What a certificate rule provides: the functions to learn and the conditions they must
+satisfy, as neutral formulas over placeholders for each function and its derivative.
+
+A condition holds when `region ∧ guard ∧ ¬claim` is unsatisfiable; the placeholders
+`$V` and `$dV` (per function) are replaced by exact formulas only when verifying.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from fossil_dsl.diagnostics import FslError
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.sets import SetExpr
+from fossil_dsl.ir.spec import CheckedSpec, Layer, TimeDomain
+
+
+def value_of(function: str) -> E.Var:
+    """The placeholder for a learned function's value at x."""
+    return E.Var(f"${function}")
+
+
+def change_of(function: str) -> E.Var:
+    """The placeholder for its derivative along the flow (continuous time) or its
+    one-step difference C(f(x)) - C(x) (discrete time)."""
+    return E.Var(f"$d{function}")
+
+
+@dataclass(frozen=True)
+class LearnedFunction:
+    name: str  # "V", "B"
+    layers: tuple[Layer, ...]
+    zero_at_origin: bool  # C(0) = 0 by construction (no biases, C(x) - C(0))
+    candidate: E.Expr | None = None  # given by the user: verify only
+
+
+@dataclass(frozen=True)
+class Condition:
+    name: str
+    text: str  # in plain mathematics
+    region: SetExpr  # x ranges over this set
+    claim: L.Formula  # must hold there; over states and placeholders
+    guard: L.Formula = L.TRUE  # further hypotheses over placeholders (e.g. B(x) = 0)
+    exclude_origin: bool = False
+    samples: str = "domain"  # the role whose samples train this condition
+    scaled_margin: bool = False  # learn with a margin growing as |x|^2 (near 0)
+
+    def query(self, states) -> L.Formula:
+        """Satisfiable exactly when the condition fails (before substitution)."""
+        parts = [self.region.contains_formula(states), self.guard, L.negation(self.claim)]
+        if self.exclude_origin:
+            norm = E.add(*(E.power(E.Var(s), E.Num(2)) for s in states))
+            parts.insert(1, L.Compare(">", norm, E.ZERO))
+        return L.conjunction(*parts)
+
+
+def level_set(function: str, level: E.Expr = E.ZERO) -> L.Formula:
+    value = value_of(function)
+    return L.conjunction(L.Compare("<=", value, level), L.Compare(">=", value, level))
+
+
+class Certificate:
+    """A certificate rule for one property form."""
+
+    form: ClassVar[str]  # the property form it proves (check.properties.FORMS)
+    title: ClassVar[str]
+
+    def __init__(self, spec: CheckedSpec):
+        self.spec = spec
+
+    def functions(self) -> tuple[LearnedFunction, ...]:
+        raise NotImplementedError
+
+    def conditions(self) -> tuple[Condition, ...]:
+        raise NotImplementedError
+
+    def guarantee(self) -> str:
+        raise NotImplementedError
+
+    @property
+    def discrete(self) -> bool:
+        return self.spec.time is TimeDomain.DISCRETE
+
+    def role(self, name: str) -> SetExpr:
+        return self.spec.property.role(name)
+
+    def change_word(self, function: str) -> str:
+        return f"{function}(f(x)) - {function}(x)" if self.discrete else f"d{function}/dt"
+
+
+class UnsupportedProperty(FslError):
+    pass
+
+
+CERTIFICATES: dict[str, type[Certificate]] = {}
+
+
+def register(cls: type[Certificate]) -> type[Certificate]:
+    """Class decorator: this certificate proves properties of form `cls.form`."""
+    CERTIFICATES[cls.form] = cls
+    return cls
+
+
+def certificate_for(spec: CheckedSpec) -> Certificate:
+    form = spec.property.form
+    if form not in CERTIFICATES:
+        raise UnsupportedProperty(
+            f"no certificate is implemented yet for {form}; available: "
+            + ", ".join(sorted(CERTIFICATES)))
+    return CERTIFICATES[form](spec)

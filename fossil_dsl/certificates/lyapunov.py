@@ -1,0 +1,37 @@
+"""Lyapunov functions: stability of the origin on the domain."""
+from __future__ import annotations
+
+from fossil_dsl.certificates.base import (Certificate, Condition, LearnedFunction,
+                                          change_of, register, value_of)
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.spec import Layer
+
+
+@register
+class Lyapunov(Certificate):
+    form = "stability"
+    title = "Lyapunov function"
+
+    def functions(self):
+        options = self.spec.synthesis
+        layers = options.certificate or (Layer("square", 8),)
+        return (LearnedFunction("V", layers, zero_at_origin=True,
+                                candidate=options.candidate),)
+
+    def conditions(self):
+        domain = self.spec.domain
+        return (
+            Condition("positive", "V(x) > 0 for every x in D, x ≠ 0", domain,
+                      L.Compare(">", value_of("V"), E.ZERO), exclude_origin=True,
+                      scaled_margin=True),
+            Condition("decrease", f"{self.change_word('V')} < 0 for every x in D, x ≠ 0",
+                      domain, L.Compare("<", change_of("V"), E.ZERO), exclude_origin=True,
+                      scaled_margin=True),
+        )
+
+    def guarantee(self):
+        step = "every step" if self.discrete else "along every trajectory"
+        return ("the origin is asymptotically stable: V is positive away from the origin "
+                f"and strictly decreases {step} in the domain, so trajectories that remain in "
+                "the domain converge to the origin (V(0) = 0 by construction)")

@@ -1,0 +1,90 @@
+"""Exact symbolic derivatives of neutral expressions (for Lie derivatives of certificates)."""
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+from fossil_dsl.ir import expr as E
+
+TWO = E.Num(2)
+
+
+def derivative(expr: E.Expr, var: str, memo: dict | None = None) -> E.Expr:
+    """d expr / d var. Shared subtrees are differentiated once."""
+    memo = {} if memo is None else memo
+    if expr in memo:
+        return memo[expr]
+    result = _derivative(expr, var, memo)
+    memo[expr] = result
+    return result
+
+
+def _derivative(expr: E.Expr, var: str, memo: dict) -> E.Expr:
+    d = lambda e: derivative(e, var, memo)  # noqa: E731
+    if isinstance(expr, E.Var):
+        return E.ONE if expr.name == var else E.ZERO
+    if isinstance(expr, (E.Num, E.Pi)):
+        return E.ZERO
+    if isinstance(expr, E.Add):
+        return E.add(*(d(t) for t in expr.terms))
+    if isinstance(expr, E.Neg):
+        return E.neg(d(expr.operand))
+    if isinstance(expr, E.Mul):
+        return _product_rule(expr.factors, d)
+    if isinstance(expr, E.Div):
+        num, den = expr.numerator, expr.denominator
+        return E.div(E.add(E.mul(d(num), den), E.neg(E.mul(num, d(den)))), E.power(den, TWO))
+    if isinstance(expr, E.Pow):
+        return _power_rule(expr, d)
+    if isinstance(expr, E.Apply):
+        return E.mul(_outer_derivative(expr.func, expr.arg), d(expr.arg))
+    raise TypeError(f"cannot differentiate {expr!r}")
+
+
+def _product_rule(factors, d) -> E.Expr:
+    terms = []
+    for i, factor in enumerate(factors):
+        df = d(factor)
+        if df != E.ZERO:
+            terms.append(E.mul(*factors[:i], df, *factors[i + 1:]))
+    return E.add(*terms) if terms else E.ZERO
+
+
+def _power_rule(expr: E.Pow, d) -> E.Expr:
+    base, exponent = expr.base, expr.exponent
+    if not E.free_vars(exponent):
+        return E.mul(exponent, E.power(base, E.add(exponent, E.Num(-1))), d(base))
+    # a^b = exp(b log a)
+    return E.mul(expr, E.add(E.mul(d(exponent), E.apply("log", base)),
+                             E.div(E.mul(exponent, d(base)), base)))
+
+
+def _outer_derivative(func: str, arg: E.Expr) -> E.Expr:
+    rules = {
+        "sin": lambda: E.apply("cos", arg),
+        "cos": lambda: E.neg(E.apply("sin", arg)),
+        "tan": lambda: E.add(E.ONE, E.power(E.apply("tan", arg), TWO)),
+        "exp": lambda: E.apply("exp", arg),
+        "log": lambda: E.div(E.ONE, arg),
+        "sqrt": lambda: E.div(E.ONE, E.mul(TWO, E.apply("sqrt", arg))),
+        "tanh": lambda: E.add(E.ONE, E.neg(E.power(E.apply("tanh", arg), TWO))),
+        "atan": lambda: E.div(E.ONE, E.add(E.ONE, E.power(arg, TWO))),
+        # |x|' = x/|x| away from 0; certificates use abs only through relu
+        "abs": lambda: E.div(arg, E.apply("abs", arg)),
+    }
+    return rules[func]()
+
+
+def gradient(expr: E.Expr, variables: Sequence[str]) -> tuple[E.Expr, ...]:
+    return tuple(derivative(expr, v, {}) for v in variables)  # one memo per variable
+
+
+def lie_derivative(expr: E.Expr, variables: Sequence[str],
+                   field: Sequence[E.Expr]) -> E.Expr:
+    """∇expr · field: the derivative of expr along the flow of x' = field."""
+    return E.add(*(E.mul(g, f) for g, f in zip(gradient(expr, variables), field)))
+
+
+def compose(expr: E.Expr, variables: Sequence[str], images: Sequence[E.Expr]) -> E.Expr:
+    """expr with each variable replaced by its image: V(f(x))."""
+    mapping: Mapping[str, E.Expr] = dict(zip(variables, images))
+    return E.substitute(expr, mapping)

@@ -1,0 +1,1 @@
+"""The learner: torch networks, samples of sets, and one loss term per condition."""

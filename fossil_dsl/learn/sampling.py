@@ -1,0 +1,47 @@
+"""Samples of sets: uniform in a bounding box, kept where the exact membership formula
+holds (evaluated numerically)."""
+from __future__ import annotations
+
+from typing import Sequence
+
+import torch
+
+from fossil_dsl.ir.sets import SetExpr
+from fossil_dsl.learn.evaluate import holds, state_env
+
+MAX_ROUNDS = 50
+
+
+def sample(region: SetExpr, states: Sequence[str], count: int, generator: torch.Generator,
+           fallback_box=None) -> torch.Tensor:
+    """Up to `count` points of `region` (fewer if the set is very thin in its box)."""
+    box = region.bounding_box() or fallback_box
+    if box is None:
+        raise ValueError(f"cannot sample {region}: no bounding box")
+    low = torch.tensor(box[0], dtype=torch.float64)
+    high = torch.tensor(box[1], dtype=torch.float64)
+    formula = region.contains_formula(states)
+    found: list[torch.Tensor] = []
+    total = 0
+    for _ in range(MAX_ROUNDS):
+        batch = low + (high - low) * torch.rand(max(count, 64) * 2, len(states),
+                                                generator=generator, dtype=torch.float64)
+        inside = batch[holds(formula, state_env(states, batch), len(batch))]
+        found.append(inside)
+        total += len(inside)
+        if total >= count:
+            break
+    return torch.cat(found)[:count]
+
+
+def around(points: torch.Tensor, region: SetExpr, states: Sequence[str], count: int,
+           radius: float, generator: torch.Generator) -> torch.Tensor:
+    """The points plus `count` random neighbours of each that lie in `region`."""
+    if count == 0 or len(points) == 0:
+        return points
+    noise = torch.randn(len(points) * count, points.shape[1], generator=generator,
+                        dtype=torch.float64) * radius
+    neighbours = points.repeat_interleave(count, 0) + noise
+    keep = holds(region.contains_formula(states), state_env(states, neighbours),
+                 len(neighbours))
+    return torch.cat([points, neighbours[keep]])

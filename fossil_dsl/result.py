@@ -1,0 +1,154 @@
+"""The result of a run, what it means in words, and the files a user keeps: result.json,
+certificate.txt and the SMT-LIB 2 proof obligations (one file per condition)."""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+from fossil_dsl.version import __version__
+from fossil_dsl.cegis.loop import CegisOutcome
+from fossil_dsl.ir import expr as E
+from fossil_dsl.plan import Plan
+from fossil_dsl.smt.api import Status
+from fossil_dsl.smt.smtlib import query_text
+
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ConditionReport:
+    name: str
+    text: str
+    status: str  # "unsat" (proved), "sat" (counterexample), "unknown"
+    reason: str
+    counterexample: tuple[Fraction, ...] | None
+
+
+@dataclass(frozen=True)
+class Result:
+    plan: Plan
+    certified: bool
+    reason: str
+    formulas: dict[str, E.Expr]
+    conditions: tuple[ConditionReport, ...]
+    obligations: dict[str, str]  # condition name -> SMT-LIB 2 script (unsat = proved)
+    iterations: int
+    learn_seconds: float
+    verify_seconds: float
+    total_seconds: float
+
+    @property
+    def verdict(self) -> str:
+        return "certified" if self.certified else "not certified"
+
+    @property
+    def exit_code(self) -> int:
+        return 0 if self.certified else 1
+
+    def guarantee(self) -> str:
+        if not self.certified:
+            return "nothing is proved"
+        return self.plan.certificate.guarantee()
+
+    def assumptions(self) -> list[str]:
+        plan = self.plan
+        found = [f"every condition was proved by {plan.verifier} (its queries were UNSAT) "
+                 "for the exact formulas shown",
+                 "the conditions are checked only inside the domain D"]
+        if any(f.candidate is None for f in plan.functions):
+            found.append(f"network weights were rounded to {plan.options.digits} decimals "
+                         "before verifying; the rounded function is the one proved")
+        return found
+
+    def to_json(self) -> dict:
+        plan = self.plan
+        return {
+            "schema": SCHEMA_VERSION,
+            "fossil_dsl": __version__,
+            "spec": {"name": plan.spec.name, "path": plan.spec.path},
+            "property": {"form": plan.spec.property.form, "formula": plan.spec.property.text},
+            "certificate": plan.certificate.title,
+            "verdict": self.verdict,
+            "reason": self.reason,
+            "guarantee": self.guarantee(),
+            "assumptions": self.assumptions() if self.certified else [],
+            "functions": {name: str(f) for name, f in self.formulas.items()},
+            "conditions": [_condition_json(c) for c in self.conditions],
+            "verifier": plan.verifier,
+            "iterations": self.iterations,
+            "seed": plan.options.seed,
+            "seconds": {"learn": round(self.learn_seconds, 3),
+                        "verify": round(self.verify_seconds, 3),
+                        "total": round(self.total_seconds, 3)},
+        }
+
+
+def _condition_json(report: ConditionReport) -> dict:
+    point = [str(v) for v in report.counterexample] if report.counterexample else None
+    return {"name": report.name, "text": report.text, "status": report.status,
+            "reason": report.reason, "counterexample": point}
+
+
+def build_result(plan: Plan, outcome: CegisOutcome, total_seconds: float) -> Result:
+    texts = {c.name: c.text for c in plan.conditions}
+    reports = tuple(ConditionReport(v.condition, texts[v.condition], v.status.value, v.reason,
+                                    v.counterexample) for v in outcome.verdicts)
+    return Result(plan, outcome.certified, outcome.reason, dict(outcome.formulas), reports,
+                  obligations(plan, outcome), len(outcome.history), outcome.learn_seconds,
+                  outcome.verify_seconds, total_seconds)
+
+
+def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
+    """Each condition's query with the certificate as a named, defined function."""
+    functions = {}
+    for name, formula in outcome.formulas.items():
+        functions[name] = formula
+        functions[f"d{name}"] = outcome.changes[name]
+    change = "one-step difference C(f(x)) - C(x)" if plan.certificate.discrete else \
+        "derivative along the flow, grad C . f"
+    scripts = {}
+    for condition in plan.conditions:
+        comments = [f"{plan.spec.name}: condition {condition.name}: {condition.text}",
+                    "unsat means the condition holds",
+                    f"each dC below is the {change}, computed exactly from C"]
+        scripts[condition.name] = query_text(condition.query(plan.states), plan.states,
+                                             functions, comments)
+    return scripts
+
+
+def summary_text(result: Result) -> str:
+    plan = result.plan
+    lines = [f"{plan.spec.name}: {result.verdict.upper()} ({plan.spec.property.form}, "
+             f"{plan.certificate.title})"]
+    if not result.certified:
+        lines.append(f"  why: {result.reason}")
+    for name, formula in result.formulas.items():
+        lines.append(f"  {name}(x) = {formula}")
+    for report in result.conditions:
+        mark = {"unsat": "proved", "sat": "fails", "unknown": "unknown"}[report.status]
+        extra = ""
+        if report.counterexample:
+            extra = " at (" + ", ".join(format(float(v), ".6g") for v in report.counterexample) + ")"
+        elif report.reason:
+            extra = f" ({report.reason})"
+        lines.append(f"  [{mark}] {report.text}{extra}")
+    lines.append(f"  guarantee: {result.guarantee()}")
+    if result.certified:
+        lines += [f"  assumes: {a}" for a in result.assumptions()]
+    lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
+                 f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"
+                 f"{'' if result.iterations == 1 else 's'}, verifier {plan.verifier}, "
+                 f"seed {plan.options.seed}")
+    return "\n".join(lines)
+
+
+def write_artefacts(result: Result, directory: str | Path) -> Path:
+    out = Path(directory)
+    (out / "obligations").mkdir(parents=True, exist_ok=True)
+    (out / "result.json").write_text(json.dumps(result.to_json(), indent=2) + "\n")
+    (out / "certificate.txt").write_text(summary_text(result) + "\n")
+    for name, script in result.obligations.items():
+        (out / "obligations" / f"{name}.smt2").write_text(script)
+    return out

@@ -1,0 +1,45 @@
+"""CVC5: decides the SMT-LIB 2 text of a query (the same text that is exported), so what
+CVC5 proves is exactly what a user can re-check."""
+from __future__ import annotations
+
+from typing import Sequence
+
+import cvc5
+
+from fossil_dsl.ir import logic as L
+from fossil_dsl.smt.api import Answer, Status, UnsupportedTheory
+from fossil_dsl.smt.smtlib import query_text
+
+
+class Cvc5Backend:
+    name = "cvc5"
+
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+        try:
+            text = query_text(formula, variables)
+        except UnsupportedTheory as exc:
+            return Answer(Status.UNKNOWN, reason=str(exc))
+        return self.check_text(text, timeout, variables)
+
+    def check_text(self, text: str, timeout: float, variables: Sequence[str] = ()) -> Answer:
+        solver = cvc5.Solver()
+        solver.setOption("produce-models", "true")
+        solver.setOption("tlimit-per", str(max(1, int(timeout * 1000))))
+        symbols = cvc5.SymbolManager(solver.getTermManager())
+        parser = cvc5.InputParser(solver, symbols)
+        parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, _without_check_sat(text), "query")
+        while not (command := parser.nextCommand()).isNull():
+            command.invoke(solver, symbols)
+        result = solver.checkSat()
+        if result.isUnsat():
+            return Answer(Status.UNSAT)
+        if result.isSat():
+            declared = {str(t): t for t in symbols.getDeclaredTerms()}
+            model = {v: solver.getValue(declared[v]).getRealValue() for v in variables
+                     if v in declared}
+            return Answer(Status.SAT, model)
+        return Answer(Status.UNKNOWN, reason=str(result.getUnknownExplanation()))
+
+
+def _without_check_sat(text: str) -> str:
+    return "\n".join(line for line in text.splitlines() if line.strip() != "(check-sat)")
