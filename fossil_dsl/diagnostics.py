@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import difflib
+import functools
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Iterable, Sequence
@@ -27,9 +28,12 @@ class Source:
     path: str
     text: str
 
+    @functools.cached_property
+    def lines(self) -> list[str]:
+        return self.text.splitlines()
+
     def line_text(self, line: int) -> str:
-        lines = self.text.splitlines()
-        return lines[line - 1] if 0 < line <= len(lines) else ""
+        return self.lines[line - 1] if 0 < line <= len(self.lines) else ""
 
 
 class Severity(Enum):
@@ -63,15 +67,15 @@ MAX_SHOWN_LINE = 200
 
 
 def _caret_lines(source: Source, span: Span) -> list[str]:
-    text = "".join(c if c.isprintable() else "?" for c in
-                   source.line_text(span.line).expandtabs(1))
-    if not text.strip():
-        return []
+    text = source.line_text(span.line)
     start = max(span.column - 1, 0)
     if len(text) > MAX_SHOWN_LINE:
         offset = max(0, start - MAX_SHOWN_LINE // 2)
         text = text[offset:offset + MAX_SHOWN_LINE]
         start -= offset
+    text = "".join(c if c.isprintable() else " " if c == "\t" else "?" for c in text)
+    if not text.strip():
+        return []
     width = 1
     if span.end_line == span.line and span.end_column:
         width = max(1, min(span.end_column - span.column, len(text) - start))

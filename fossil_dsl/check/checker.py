@@ -235,7 +235,8 @@ class Checker:
         prover = RelationProver(self.context, self.context.states, Z3Backend())
         prover.nonempty(Subject(domain, "the domain", self.spans.get("domain")))
         for name, value in named.items():
-            prover.nonempty(self.subject(value))
+            if name in self.context.used:  # unused sets only get a warning
+                prover.nonempty(self.subject(value))
         subjects = {role: self.subject(value, role) for role, value in prop.roles.items()}
         for kind, first, second in form.relations:
             prover.prove(kind, subjects[first], subjects[second])

@@ -83,10 +83,13 @@ class ExpressionChecker:
                                f"limited to ±{MAX_DECIMAL_EXPONENT})", node.span)
             return E.ZERO
         try:
-            return E.Num(Fraction(node.text))
+            value = Fraction(node.text)
         except ValueError:
+            value = None
+        if value is None or E.too_large(value):
             self.context.error(f"number {node.text[:20]}... has too many digits", node.span)
             return E.ZERO
+        return E.Num(value)
 
     def name(self, node: ast.Name) -> E.Expr:
         kind = self.context.kind_of(node.name)

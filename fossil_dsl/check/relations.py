@@ -7,6 +7,7 @@ arithmetic, or by an outward-rounded enclosure that excludes 0.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from decimal import Decimal, localcontext
 from fractions import Fraction
 from typing import Sequence
 
@@ -28,7 +29,11 @@ def point_text(values: Sequence[Fraction]) -> str:
 
 def _coordinate(value: Fraction) -> str:
     text = number_text(value)
-    return text if len(text) <= 12 and "/" not in text else format(float(value), ".6g")
+    if len(text) <= 12 and "/" not in text:
+        return text
+    with localcontext() as context:
+        context.prec = 6
+        return format(Decimal(value.numerator) / Decimal(value.denominator), "g")
 
 
 @dataclass(frozen=True)
@@ -88,7 +93,12 @@ class RelationProver:
 
     def contains_origin(self, a: Subject) -> None:
         origin = [E.ZERO] * len(self.states)
-        query = L.negation(a.value.membership(origin))
+        try:
+            query = L.negation(a.value.membership(origin))
+        except E.ExprError as exc:
+            self.context.error(f"{a.text} is undefined at the origin ({exc}), so it cannot "
+                               "contain the equilibrium that the controller keeps", a.span)
+            return
         if self._query(query, f"{a.text} contains the origin", a.span) is not None:
             self.context.error(f"{a.text} does not contain the origin, the equilibrium that "
                                "the controller (with k(0) = 0) keeps", a.span)

@@ -9,6 +9,7 @@ from __future__ import annotations
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
 from fossil_dsl.diagnostics import Span, article, did_you_mean
+from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.syntax import ast
@@ -103,7 +104,13 @@ class SetChecker:
         if any(value is None for value in values):
             return None
         shape = cls(*values, is_open=node.is_open)
-        for arg_index, component, message in shape.problems():
+        try:
+            problems = shape.problems()
+            shape.membership([E.Var(s) for s in self.context.states])
+        except E.ExprError as exc:
+            self.context.error(f"`{node.kind}` parameters out of range: {exc}", node.span)
+            return None
+        for arg_index, component, message in problems:
             self.context.error(message, _argument_span(node.args[arg_index], component))
         return shape
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Callable, Mapping
 
-MAX_CONSTANT_BITS = 20_000  # exact constants beyond this are rejected, not computed
+MAX_CONSTANT_BITS = 4_000  # about 1e1200; beyond it constants are rejected, not computed
 
 
 class ExprError(ValueError):
@@ -104,9 +104,14 @@ def lift(value) -> Expr:
 
 
 def _checked(value: Fraction) -> Num:
-    if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > MAX_CONSTANT_BITS:
+    if too_large(value):
         raise ExprError("constant too large to compute exactly")
     return Num(value)
+
+
+def too_large(value: Fraction) -> bool:
+    return max(abs(value.numerator).bit_length(), value.denominator.bit_length()) \
+        > MAX_CONSTANT_BITS
 
 
 def is_num(expr: Expr, value=None) -> bool:
@@ -178,6 +183,7 @@ def div(numerator: Expr, denominator: Expr) -> Expr:
 
 
 MAX_EXPONENT = 10_000
+MAX_DEGREE = 64  # integer powers of non-constants: solvers stall on higher degrees
 
 
 def power(base: Expr, exponent: Expr) -> Expr:
@@ -191,6 +197,9 @@ def power(base: Expr, exponent: Expr) -> Expr:
             return ONE
         if isinstance(base, Num):
             return _fold_power(base.value, n)
+        if abs(n) > MAX_DEGREE and free_vars(base):
+            raise ExprError(f"exponent {n} is too large for a power of a variable "
+                            f"(at most {MAX_DEGREE})")
     return Pow(base, exponent)
 
 

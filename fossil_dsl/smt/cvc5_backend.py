@@ -28,8 +28,11 @@ class Cvc5Backend:
         symbols = cvc5.SymbolManager(solver.getTermManager())
         parser = cvc5.InputParser(solver, symbols)
         parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, _without_check_sat(text), "query")
-        while not (command := parser.nextCommand()).isNull():
-            command.invoke(solver, symbols)
+        try:
+            while not (command := parser.nextCommand()).isNull():
+                command.invoke(solver, symbols)
+        except RuntimeError as exc:  # cvc5's parse and API errors
+            return Answer(Status.UNKNOWN, reason=f"CVC5 could not read the script: {exc}")
         result = solver.checkSat()
         if result.isUnsat():
             return Answer(Status.UNSAT)

@@ -88,14 +88,25 @@ class Printer:
         raise TypeError(f"not a formula: {formula!r}")
 
 
+def _logic(formula: L.Formula, definitions) -> str:
+    """QF_NRA where it fits: CVC5 then uses its complete procedure for real arithmetic."""
+    definitions = list(definitions)
+    expressions = [side for c in L.comparisons(formula) for side in (c.left, c.right)]
+    expressions += [d for d in definitions if d is not None]
+    if not all(E.is_arithmetic(e) for e in expressions):
+        return "ALL"
+    return "QF_UFNRA" if None in definitions else "QF_NRA"
+
+
 def query_text(formula: L.Formula, states: Sequence[str],
                functions: Mapping[str, E.Expr | None] = {}, comments: Sequence[str] = (),
-               logic: str = "ALL") -> str:
+               logic: str | None = None) -> str:
     """A complete SMT-LIB 2 script: unsat means the condition holds.
 
     `functions` maps a placeholder name ("V", "dV") to its definition, or to None to
     declare it as an unknown function (a query before anything is learned)."""
     printer = Printer(states)
+    logic = logic or _logic(formula, functions.values())
     lines = [f"; {c}" for c in comments]
     lines.append(f"(set-logic {logic})")
     lines += [f"(declare-const {s} Real)" for s in states]

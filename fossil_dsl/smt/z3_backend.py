@@ -5,6 +5,7 @@ sound enclosure; the answer then carries `approximate=True`.
 """
 from __future__ import annotations
 
+import threading
 from fractions import Fraction
 from typing import Sequence
 
@@ -108,7 +109,7 @@ class Z3Backend:
         solver.set("timeout", max(1, int(timeout * 1000)))
         solver.add(term, *converter.side_conditions)
         approximate = bool(converter.side_conditions)
-        result = solver.check()
+        result = _check_with_deadline(solver, context, timeout)
         if result == z3.unsat:
             return Answer(Status.UNSAT, approximate=approximate)
         if result == z3.sat:
@@ -122,13 +123,28 @@ def check_smtlib(text: str, timeout: float) -> Answer:
     context = z3.Context()
     solver = z3.Solver(ctx=context)
     solver.set("timeout", max(1, int(timeout * 1000)))
-    solver.from_string(text)
-    result = solver.check()
+    try:
+        solver.from_string(text)
+    except z3.Z3Exception as exc:
+        return Answer(Status.UNKNOWN, reason=f"Z3 could not read the script: {exc}")
+    result = _check_with_deadline(solver, context, timeout)
     if result == z3.unsat:
         return Answer(Status.UNSAT)
     if result == z3.sat:
         return Answer(Status.SAT)
     return Answer(Status.UNKNOWN, reason=solver.reason_unknown())
+
+
+def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float):
+    """solver.check(), interrupted from a timer if Z3 overruns its own timeout (nlsat does
+    not always look at the clock, e.g. on high-degree polynomials)."""
+    timer = threading.Timer(timeout + 1.0, context.interrupt)
+    timer.daemon = True
+    timer.start()
+    try:
+        return solver.check()
+    finally:
+        timer.cancel()
 
 
 def _model(model: z3.ModelRef, variables) -> list[Fraction]:

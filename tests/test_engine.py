@@ -1,0 +1,225 @@
+"""The synthesis engine end to end: certified runs, false properties never certified,
+wrong certificates rejected, honest UNKNOWN, and obligations re-checked by another solver."""
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import fossil_dsl
+from fossil_dsl.cegis.loop import Cegis
+from fossil_dsl.plan import compile_spec, loss_text, plan_text, symbolic_queries
+from fossil_dsl.result import build_result, write_artefacts
+from fossil_dsl.smt.api import Answer, Status
+from fossil_dsl.smt.cvc5_backend import Cvc5Backend
+from fossil_dsl.smt.z3_backend import Z3Backend
+
+ROOT = Path(__file__).resolve().parent.parent
+FOSSILC = Path(sys.executable).with_name("fossilc")
+ENGINE_SPECS = ["stability_continuous", "stability_discrete", "safety_continuous",
+                "safety_discrete"]
+OTHER_SOLVER = {"z3": Cvc5Backend, "cvc5": Z3Backend}
+
+
+def spec_file(name: str):
+    return fossil_dsl.load(ROOT / "specs" / f"{name}.fsl")
+
+
+def spec_text(text: str):
+    return fossil_dsl.loads(text, "test.fsl")
+
+
+@pytest.mark.parametrize("name", ENGINE_SPECS)
+def test_bundled_specs_are_certified_with_defaults(name, tmp_path):
+    result = fossil_dsl.synthesise(spec_file(name), seed=0)
+    assert result.certified, result.reason
+    assert result.exit_code == 0
+    assert all(c.status == "unsat" for c in result.conditions)
+    # the exported obligations are UNSAT for a second, independent solver
+    write_artefacts(result, tmp_path)
+    other = OTHER_SOLVER[result.plan.verifier]()
+    files = sorted((tmp_path / "obligations").glob("*.smt2"))
+    assert {f.stem for f in files} == {c.name for c in result.plan.conditions}
+    for path in files:
+        answer = other.check_text(path.read_text(), timeout=60)
+        assert answer.status is Status.UNSAT, (path.name, answer)
+
+
+def test_cvc5_as_the_verifier_and_z3_rechecks(tmp_path):
+    result = fossil_dsl.synthesise(spec_file("stability_continuous"), verifier="cvc5", seed=1)
+    assert result.certified and result.plan.verifier == "cvc5"
+    for script in result.obligations.values():
+        assert Z3Backend().check_text(script, timeout=60).status is Status.UNSAT
+
+
+def test_same_seed_same_run():
+    spec = spec_file("safety_continuous")
+    first = fossil_dsl.synthesise(spec, seed=3)
+    second = fossil_dsl.synthesise(spec, seed=3)
+    assert first.formulas == second.formulas and first.iterations == second.iterations
+
+
+def test_certificate_is_exact_and_reported(tmp_path):
+    import json
+    result = fossil_dsl.synthesise(spec_file("stability_discrete"), seed=0)
+    write_artefacts(result, tmp_path)
+    data = json.loads((tmp_path / "result.json").read_text())
+    assert data["verdict"] == "certified"
+    assert data["functions"]["V"] == str(result.formulas["V"])
+    assert "asymptotically stable" in data["guarantee"]
+    assert any("rounded" in a for a in data["assumptions"])
+    assert "V(x) = " in (tmp_path / "certificate.txt").read_text()
+
+
+# ---- soundness: false properties are never certified, whatever the seed -------------
+FALSE_PROPERTIES = {
+    "saddle-origin": """\
+state x0, x1
+dynamics continuous {
+    x0' = x0 + x1
+    x1' = -x1
+}
+domain ball([0, 0], 1)
+prove stable
+""",
+    "expanding-map": """\
+state x0, x1
+dynamics discrete {
+    next(x0) = 1.1*x0
+    next(x1) = 0.5*x1
+}
+domain box([-1, -1], [1, 1])
+prove stable
+""",
+    "flow-into-unsafe": """\
+state x0, x1
+dynamics continuous {
+    x0' = 1
+    x1' = -x1
+}
+domain box([-2, -2], [2, 2])
+set init = box([-0.5, -0.5], [0, 0.5])
+set unsafe = box([1, -2], [2, 2])
+prove from init: always not unsafe
+""",
+    "map-into-unsafe": """\
+state x0, x1
+dynamics discrete {
+    next(x0) = x0 + 0.5
+    next(x1) = 0.5*x1
+}
+domain box([-2, -2], [2, 2])
+set init = box([-0.5, -0.5], [0, 0.5])
+set unsafe = box([1, -2], [2, 2])
+prove from init: always not unsafe
+""",
+}
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("name", FALSE_PROPERTIES)
+def test_false_property_is_never_certified(name, seed):
+    result = fossil_dsl.synthesise(spec_text(FALSE_PROPERTIES[name]), seed=seed, max_iters=2,
+                                   learn_steps=300, query_timeout=5)
+    assert not result.certified
+    assert result.exit_code == 1
+    assert result.guarantee() == "nothing is proved"
+    assert any(c.status != "unsat" for c in result.conditions)
+
+
+# ---- the verifier alone: a wrong certificate is rejected with a counterexample ------
+LINEAR = """\
+state x0, x1
+dynamics continuous {
+    x0' = -x0
+    x1' = -x1
+}
+domain ball([0, 0], 1)
+prove stable
+"""
+
+
+def test_wrong_candidate_rejected_with_counterexample():
+    result = fossil_dsl.synthesise(spec_text(LINEAR + "synthesis { candidate: x0^2 - x1^2 }\n"))
+    assert not result.certified and result.iterations == 1
+    failing = [c for c in result.conditions if c.status == "sat"]
+    assert failing and failing[0].counterexample is not None
+    x0, x1 = failing[0].counterexample
+    if failing[0].name == "positive":  # the counterexample really violates V > 0
+        assert x0 ** 2 - x1 ** 2 <= 0 and (x0, x1) != (0, 0)
+
+
+def test_right_candidate_certified_without_learning():
+    result = fossil_dsl.synthesise(spec_text(LINEAR + "synthesis { candidate: x0^2 + 2*x1^2 }\n"))
+    assert result.certified and result.learn_seconds < 0.5
+    assert str(result.formulas["V"]) == "x0^2 + 2*x1^2"
+
+
+# ---- UNKNOWN and SAT never count as proved ---------------------------------------------
+class ScriptedBackend:
+    name = "scripted"
+
+    def __init__(self, status):
+        self.status = status
+
+    def check(self, formula, variables, timeout):
+        model = {v: 0 for v in variables} if self.status is Status.SAT else None
+        return Answer(self.status, model, reason="scripted")
+
+
+@pytest.mark.parametrize("status", [Status.UNKNOWN, Status.SAT])
+def test_loop_only_certifies_on_unsat(status):
+    plan = compile_spec(spec_file("stability_continuous"), max_iters=2, learn_steps=50)
+    outcome = Cegis(plan, ScriptedBackend(status)).run()
+    assert not outcome.certified
+    assert all(v.status is status for v in outcome.verdicts)
+    result = build_result(plan, outcome, 0.0)
+    assert result.verdict == "not certified"
+
+
+def test_timeout_ends_the_run_not_certified():
+    result = fossil_dsl.synthesise(spec_text(FALSE_PROPERTIES["saddle-origin"]), timeout=1,
+                                   max_iters=100)
+    assert not result.certified and "timeout" in result.reason
+
+
+# ---- the plan and its readable forms -------------------------------------------------
+def test_plan_readable_forms():
+    plan = compile_spec(spec_file("safety_continuous"))
+    text = plan_text(plan)
+    assert "dB/dt < 0 for every x in D with B(x) = 0" in text
+    assert "verifier: z3" in text
+    queries = symbolic_queries(plan)
+    assert set(queries) == {"initial", "unsafe", "flow"}
+    assert "(declare-fun B (Real Real) Real)" in queries["flow"]
+    for script in queries.values():  # well-formed SMT-LIB: both solvers parse it
+        assert Z3Backend().check_text(script, timeout=10).status is not None
+    assert "[flow] relu(" in loss_text(plan)
+
+
+@pytest.mark.parametrize("emit, fragment", [("plan", "certificate: barrier certificate"),
+                                            ("smt2", "(declare-fun dB (Real Real) Real)"),
+                                            ("losses", "[initial] relu(")])
+def test_compile_command(emit, fragment):
+    run = subprocess.run([str(FOSSILC), "compile", str(ROOT / "specs" / "safety_continuous.fsl"),
+                          "--emit", emit], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert fragment in run.stdout
+
+
+def test_run_writes_artefacts_with_o(tmp_path):
+    run = subprocess.run([str(FOSSILC), str(ROOT / "specs" / "stability_continuous.fsl"),
+                          "-o", str(tmp_path / "out"), "--quiet"], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert (tmp_path / "out" / "result.json").exists()
+    assert (tmp_path / "out" / "obligations" / "decrease.smt2").exists()
+
+
+def test_unsupported_property_or_controller_is_a_clear_error(tmp_path):
+    path = tmp_path / "ctrl.fsl"
+    path.write_text(LINEAR.replace("state x0, x1", "state x0, x1\ninput u").replace(
+        "-x1\n}", "-x1 + u\n}"))
+    run = subprocess.run([str(FOSSILC), str(path)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2
+    assert "not available yet" in run.stderr and "Traceback" not in run.stderr
