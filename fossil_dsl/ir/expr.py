@@ -124,7 +124,7 @@ def add(*terms: Expr) -> Expr:
     coefficients: dict[Expr, Fraction] = {}
     constant = Fraction(0)
     for term in terms:
-        for part in (term.terms if isinstance(term, Add) else (term,)):
+        for part in _summands(term):
             if isinstance(part, Num):
                 constant += part.value
             else:
@@ -134,6 +134,14 @@ def add(*terms: Expr) -> Expr:
     if constant != 0 or not flat:
         flat.append(_checked(constant))
     return flat[0] if len(flat) == 1 else Add(tuple(flat))
+
+
+def _summands(term: Expr):
+    if isinstance(term, Add):
+        return term.terms
+    if isinstance(term, Neg) and isinstance(term.operand, Add):  # -(a + b) = -a - b
+        return tuple(neg(t) for t in term.operand.terms)
+    return (term,)
 
 
 def _split_coefficient(term: Expr) -> tuple[Expr, Fraction]:

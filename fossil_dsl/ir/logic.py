@@ -112,6 +112,24 @@ def _approximate(formula: Formula, same: dict, dual: dict) -> Formula:
     return formula
 
 
+def truth(formula: Formula) -> bool | None:
+    """The exact truth value of a formula whose comparisons are between numbers."""
+    from fossil_dsl.ir.expr import Num
+    if isinstance(formula, BoolConst):
+        return formula.value
+    if isinstance(formula, Compare):
+        if not (isinstance(formula.left, Num) and isinstance(formula.right, Num)):
+            return None
+        a, b = formula.left.value, formula.right.value
+        return {"<=": a <= b, "<": a < b, ">=": a >= b, ">": a > b}[formula.relation]
+    values = [truth(a) for a in children(formula)]
+    if None in values:
+        return None
+    if isinstance(formula, Not):
+        return not values[0]
+    return all(values) if isinstance(formula, And) else any(values)
+
+
 def children(formula: Formula) -> tuple[Formula, ...]:
     if isinstance(formula, (And, Or)):
         return formula.args

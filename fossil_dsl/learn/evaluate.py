@@ -37,7 +37,8 @@ def evaluate(expr: E.Expr, env: Mapping[str, torch.Tensor]):
         return evaluate(expr.base, env) ** evaluate(expr.exponent, env)
     if isinstance(expr, E.Apply):
         value = evaluate(expr.arg, env)
-        value = value if isinstance(value, torch.Tensor) else torch.tensor(value)
+        value = value if isinstance(value, torch.Tensor) else \
+            torch.tensor(value, dtype=torch.float64)
         return _FUNCTIONS[expr.func](value)
     raise TypeError(f"cannot evaluate {expr!r}")
 

@@ -22,7 +22,9 @@ class Answer:
     status: Status
     model: Mapping[str, Fraction] | None = None
     reason: str = ""
-    approximate: bool = False  # the query bounded irrational constants by intervals
+    # True if the query bounded irrational constants by intervals, or if the model has
+    # irrational coordinates that are reported as nearby rationals
+    approximate: bool = False
 
 
 class UnsupportedTheory(FslError):

@@ -2,6 +2,7 @@
 CVC5 proves is exactly what a user can re-check."""
 from __future__ import annotations
 
+from fractions import Fraction
 from typing import Sequence
 
 import cvc5
@@ -38,10 +39,20 @@ class Cvc5Backend:
             return Answer(Status.UNSAT)
         if result.isSat():
             declared = {str(t): t for t in symbols.getDeclaredTerms()}
-            model = {v: solver.getValue(declared[v]).getRealValue() for v in variables
-                     if v in declared}
-            return Answer(Status.SAT, model)
+            values = {v: solver.getValue(declared[v]) for v in variables if v in declared}
+            irrational = not all(value.isRealValue() for value in values.values())
+            model = {v: _rational(value) for v, value in values.items()}
+            return Answer(Status.SAT, model, approximate=irrational)
         return Answer(Status.UNKNOWN, reason=str(result.getUnknownExplanation()))
+
+
+def _rational(value) -> Fraction:
+    """An exact rational, or the midpoint of an isolating interval of an algebraic one."""
+    if value.isRealValue():
+        return value.getRealValue()
+    low = value.getRealAlgebraicNumberLowerBound().getRealValue()
+    high = value.getRealAlgebraicNumberUpperBound().getRealValue()
+    return (low + high) / 2
 
 
 def _without_check_sat(text: str) -> str:

@@ -113,8 +113,11 @@ class Z3Backend:
         if result == z3.unsat:
             return Answer(Status.UNSAT, approximate=approximate)
         if result == z3.sat:
-            model = _model(solver.model(), [converter.var(v) for v in variables])
-            return Answer(Status.SAT, dict(zip(variables, model)), approximate=approximate)
+            values = [solver.model().eval(converter.var(v), model_completion=True)
+                      for v in variables]
+            irrational = any(z3.is_algebraic_value(v) for v in values)
+            model = dict(zip(variables, map(_to_fraction, values)))
+            return Answer(Status.SAT, model, approximate=approximate or irrational)
         return Answer(Status.UNKNOWN, reason=solver.reason_unknown(), approximate=approximate)
 
 
@@ -145,10 +148,6 @@ def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float)
         return solver.check()
     finally:
         timer.cancel()
-
-
-def _model(model: z3.ModelRef, variables) -> list[Fraction]:
-    return [_to_fraction(model.eval(v, model_completion=True)) for v in variables]
 
 
 def _to_fraction(value) -> Fraction:

@@ -1,0 +1,36 @@
+"""The exact formula that is verified is the function the learner trained: for every
+activation, formula(x) equals the torch network at random points."""
+import pytest
+import torch
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir.activations import ACTIVATIONS
+from fossil_dsl.ir.spec import Layer
+from fossil_dsl.learn.evaluate import evaluate, state_env
+from fossil_dsl.learn.networks import Network
+
+STATES = ("x0", "x1", "x2")
+
+
+@pytest.mark.parametrize("zero_at_origin", [True, False], ids=["no-bias", "bias"])
+@pytest.mark.parametrize("activation", list(ACTIVATIONS))
+def test_formula_equals_network(activation, zero_at_origin):
+    torch.manual_seed(7)
+    network = Network(3, (Layer(activation, 6), Layer("square", 4)), zero_at_origin)
+    network.round_weights(3)
+    formula = network.formula(STATES, digits=3)
+    points = torch.rand(50, 3, dtype=torch.float64) * 4 - 2
+    expected = network(points).detach()
+    got = torch.as_tensor(evaluate(formula, state_env(STATES, points)), dtype=torch.float64)
+    assert torch.allclose(got.expand(50), expected, rtol=1e-9, atol=1e-9)
+    if zero_at_origin:
+        assert E.substitute(formula, {s: E.ZERO for s in STATES}) == E.ZERO
+        assert float(network(torch.zeros(1, 3, dtype=torch.float64)).detach()) == 0.0
+
+
+def test_polynomial_activations_give_polynomials():
+    for name, activation in ACTIVATIONS.items():
+        network = Network(2, (Layer(name, 3),), zero_at_origin=True)
+        formula = network.formula(("x0", "x1"), digits=3)
+        assert E.is_arithmetic(formula) == (activation.polynomial_degree is not None
+                                            or name == "relu")
