@@ -3,7 +3,6 @@ the set each ranges over), what to sample, and which verifier decides the querie
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from fractions import Fraction
 from types import MappingProxyType
 from typing import Mapping
 
@@ -136,7 +135,7 @@ def plan_text(plan: Plan) -> str:
     for state, f in zip(spec.states, spec.dynamics):
         left = f"{state}{mark}" if mark else f"next({state})"
         lines.append(f"  {left} = {f}")
-    lines.append(f"samples: " + ", ".join(f"{role} {n}" for role, n in plan.samples.items()))
+    lines.append("samples: " + ", ".join(f"{role} {n}" for role, n in plan.samples.items()))
     lines.append(f"verifier: {plan.verifier} ({plan.verifier_reason})")
     options = plan.options
     lines.append(f"loop: at most {options.max_iters} iterations, {options.timeout:g} s, "

@@ -11,7 +11,6 @@ from fossil_dsl.version import __version__
 from fossil_dsl.cegis.loop import CegisOutcome
 from fossil_dsl.ir import expr as E
 from fossil_dsl.plan import Plan
-from fossil_dsl.smt.api import Status
 from fossil_dsl.smt.smtlib import query_text
 
 SCHEMA_VERSION = 1

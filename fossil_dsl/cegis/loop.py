@@ -81,10 +81,6 @@ class Cegis:
         self.states = plan.states
         self.options = plan.options
         torch.manual_seed(self.options.seed)
-        torch.set_flush_denormal(True)  # subnormal floats make training 10x slower
-        # Batches are small: a thread pool only adds waiting, and under load (another
-        # process, or parallel benchmark jobs) it made steps 30x slower (60 ms, not 2 ms).
-        torch.set_num_threads(1)
         self.generator = torch.Generator().manual_seed(self.options.seed)
         self.networks = {f.name: Network(len(self.states), f.layers, f.zero_at_origin)
                          for f in plan.functions if f.candidate is None}
@@ -92,6 +88,16 @@ class Cegis:
 
     # ---- the loop ----
     def run(self) -> CegisOutcome:
+        # Batches are small: a thread pool only adds waiting, and under load (another
+        # process, or parallel benchmark jobs) it made steps 30x slower (60 ms, not 2 ms).
+        threads = torch.get_num_threads()
+        torch.set_num_threads(1)
+        try:
+            return self._run()
+        finally:
+            torch.set_num_threads(threads)
+
+    def _run(self) -> CegisOutcome:
         state = CegisState(self.initial_samples())
         optimiser = self._optimiser()
         reason = f"gave up after {self.options.max_iters} iterations"

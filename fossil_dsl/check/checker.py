@@ -234,8 +234,8 @@ class Checker:
     def prove_facts(self, form, prop, named, domain, dynamics, equation_spans, time) -> None:
         prover = RelationProver(self.context, self.context.states, Z3Backend())
         prover.nonempty(Subject(domain, "the domain", self.spans.get("domain")))
-        for name, value in named.items():
-            if name in self.context.used:  # unused sets only get a warning
+        for value in {id(v): v for v in prop.roles.values()}.values():
+            if isinstance(value, S.Named):  # the sets the property names must not be empty
                 prover.nonempty(self.subject(value))
         subjects = {role: self.subject(value, role) for role, value in prop.roles.items()}
         for kind, first, second in form.relations:

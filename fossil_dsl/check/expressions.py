@@ -34,10 +34,15 @@ class ExpressionChecker:
 
     def convert(self, node: ast.Expr) -> E.Expr:
         try:
-            return self._convert(node)
+            value = self._convert(node)
         except E.ExprError as exc:
             self.context.error(str(exc), node.span)
             return E.ZERO
+        if E.degree(value) > E.MAX_DEGREE:
+            self.context.error(f"this expression has degree up to {E.degree(value)}; at most "
+                               f"{E.MAX_DEGREE} is supported (solvers stall beyond)", node.span)
+            return E.ZERO
+        return value
 
     def _convert(self, node: ast.Expr) -> E.Expr:
         if isinstance(node, ast.Number):

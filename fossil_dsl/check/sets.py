@@ -14,6 +14,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.syntax import ast
 
+MAX_SET_DEPTH = 50  # sets are expanded recursively, and their formulas grow with depth
 _SIGNATURE_WORDS = {"vector": "a vector [...]", "scalar": "a number"}
 _SET_OPERATORS = {"|": S.Union, "&": S.Intersection, "-": S.Difference}
 
@@ -23,7 +24,9 @@ class SetChecker:
         self.context = context
         self.declarations = declarations
         self.built: dict[str, S.SetExpr | None] = {}
+        self.depths: dict[str, int] = {}  # 1 + the depth of the deepest set it uses
         self.building: list[str] = []
+        self.deepest_reference: list[int] = []  # per set being built
         self.domain: S.SetExpr | None = None
         self.in_domain = False
         self.parameters = ExpressionChecker(context, {"constant"}, "parameter")
@@ -41,11 +44,25 @@ class SetChecker:
         if name in self.building:
             self.context.error(f"set `{name}` is defined in terms of itself", span)
             return None
+        if name not in self.built and len(self.building) >= MAX_SET_DEPTH:
+            self.context.error(f"sets defined through more than {MAX_SET_DEPTH} levels of "
+                               "other sets are not supported", span)
+            return None
         if name not in self.built:
             self.building.append(name)
+            self.deepest_reference.append(0)
             value = self.convert(self.declarations[name].value)
             self.building.pop()
+            self.depths[name] = self.deepest_reference.pop() + 1
+            if self.depths[name] > MAX_SET_DEPTH and value is not None:
+                self.context.error(f"set `{name}` is defined through more than "
+                                   f"{MAX_SET_DEPTH} levels of other sets; write it more "
+                                   "directly", self.declarations[name].name.span)
+                value = None
             self.built[name] = S.Named(name, value) if value is not None else None
+        if self.deepest_reference:
+            self.deepest_reference[-1] = max(self.deepest_reference[-1],
+                                             self.depths.get(name, 0))
         return self.built[name]
 
     def convert(self, node: ast.SetExpr) -> S.SetExpr | None:
@@ -106,13 +123,14 @@ class SetChecker:
         shape = cls(*values, is_open=node.is_open)
         try:
             problems = shape.problems()
-            shape.membership([E.Var(s) for s in self.context.states])
+            for arg_index, component, message in problems:
+                self.context.error(message, _argument_span(node.args[arg_index], component))
+            if not problems:
+                shape.membership([E.Var(s) for s in self.context.states])
         except E.ExprError as exc:
             self.context.error(f"`{node.kind}` parameters out of range: {exc}", node.span)
             return None
-        for arg_index, component, message in problems:
-            self.context.error(message, _argument_span(node.args[arg_index], component))
-        return shape
+        return shape if not problems else None
 
     def argument(self, shape: ast.Shape, arg, kind: str):
         if kind == "vector":

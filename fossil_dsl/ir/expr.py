@@ -334,6 +334,27 @@ def rebuild(expr: Expr, new_children: tuple[Expr, ...]) -> Expr:
     return expr
 
 
+def degree(expr: Expr) -> int:
+    """An upper bound on the polynomial degree (a function of a state counts as 1)."""
+    if not free_vars(expr):
+        return 0
+    if isinstance(expr, Var):
+        return 1
+    if isinstance(expr, Add):
+        return max(map(degree, expr.terms))
+    if isinstance(expr, Mul):
+        return sum(map(degree, expr.factors))
+    if isinstance(expr, Div):
+        return degree(expr.numerator) + degree(expr.denominator)
+    if isinstance(expr, Neg):
+        return degree(expr.operand)
+    if isinstance(expr, Pow) and isinstance(expr.exponent, Num):
+        return degree(expr.base) * abs(int(expr.exponent.value))
+    if isinstance(expr, Apply) and FUNCTIONS[expr.func].piecewise_linear:
+        return degree(expr.arg)  # solvers encode abs(p) with p itself
+    return 1
+
+
 def is_polynomial(expr: Expr) -> bool:
     """+, -, * and non-negative integer powers only, over rational constants."""
     for node in walk(expr):

@@ -134,7 +134,7 @@ def _open_needs_shape(token, expected):
 def _incomplete(token, expected):
     if token.type in ("_NL", "$END"):
         words = sorted({token_words(name) for name in expected})[:6]
-        return f"incomplete statement: it ends here but needs " + " or ".join(words)
+        return "incomplete statement: it ends here but needs " + " or ".join(words)
     return None
 
 
