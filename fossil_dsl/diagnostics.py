@@ -23,14 +23,19 @@ class Span:
 
 @dataclass(frozen=True)
 class Source:
-    """A spec's text and the name it is reported under."""
+    """A spec's text and the name it is reported under. Line endings are normalised to
+    \n (and a byte-order mark dropped) so positions mean the same everywhere."""
 
     path: str
     text: str
 
+    def __post_init__(self):
+        text = self.text.removeprefix("\ufeff").replace("\r\n", "\n").replace("\r", "\n")
+        object.__setattr__(self, "text", text)
+
     @functools.cached_property
     def lines(self) -> list[str]:
-        return self.text.splitlines()
+        return self.text.split("\n")  # as the parser counts lines (text is normalised)
 
     def line_text(self, line: int) -> str:
         return self.lines[line - 1] if 0 < line <= len(self.lines) else ""

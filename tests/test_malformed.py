@@ -249,3 +249,17 @@ def test_warnings_do_not_block_the_spec(text, fragment):
     result = check_text(text)
     assert result.ok, result.render()
     assert any(fragment in w.message for w in result.warnings), result.render()
+
+
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"], ids=["lf", "crlf", "cr"])
+def test_positions_agree_for_every_line_ending(newline):
+    text = newline.join(["state x0", "dynamics continuous {", "  x0' = -y", "}",
+                         "domain ball([0], 1)", "prove stable", ""])
+    [error] = check_text(text, "spec.fsl").errors
+    assert (error.span.line, error.span.column) == (3, 10)
+    assert check_text(text, "spec.fsl").render().splitlines()[1] == "    x0' = -y"
+
+
+def test_byte_order_mark_is_ignored():
+    text = "\ufeffstate x0\ndynamics continuous { x0' = -x0 }\ndomain ball([0], 1)\nprove stable\n"
+    assert check_text(text).ok

@@ -6,6 +6,7 @@ arithmetic, or by an outward-rounded enclosure that excludes 0.
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from decimal import Decimal, localcontext
 from fractions import Fraction
@@ -18,9 +19,10 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.enclosure import sign
 from fossil_dsl.ir.printing import number_text, to_text
-from fossil_dsl.smt.api import Backend, Status
+from fossil_dsl.smt.api import Answer, Backend, Status
 
-RELATION_TIMEOUT = 10.0  # seconds per query
+RELATION_TIMEOUT = 2.5  # seconds per query
+RELATION_BUDGET = 5.0  # seconds for all of a spec's queries: checking is never slow
 
 
 def point_text(values: Sequence[Fraction]) -> str:
@@ -47,18 +49,26 @@ class Subject:
 
 class RelationProver:
     def __init__(self, context: CheckContext, states: Sequence[str], backend: Backend,
-                 timeout: float = RELATION_TIMEOUT):
+                 timeout: float = RELATION_TIMEOUT, budget: float = RELATION_BUDGET):
         self.context = context
         self.states = tuple(states)
         self.backend = backend
         self.timeout = timeout
+        self.deadline = time.monotonic() + budget
+
+    def _decide(self, formula: L.Formula) -> Answer:
+        remaining = self.deadline - time.monotonic()
+        if remaining <= 0.05:
+            return Answer(Status.UNKNOWN, reason="the time for checking set relations "
+                          f"({RELATION_BUDGET:g} s) is spent")
+        return self.backend.check(formula, self.states, min(self.timeout, remaining))
 
     def _member(self, subject: Subject) -> L.Formula:
         return subject.value.contains_formula(self.states)
 
     def _query(self, formula: L.Formula, claim: str, span: Span | None):
         """A witness if `formula` is satisfiable; None if UNSAT or undecided (warned)."""
-        answer = self.backend.check(formula, self.states, self.timeout)
+        answer = self._decide(formula)
         if answer.status is Status.UNSAT:
             return None
         if answer.status is Status.SAT and not answer.approximate:
@@ -104,7 +114,7 @@ class RelationProver:
                                "the controller (with k(0) = 0) keeps", a.span)
 
     def nonempty(self, a: Subject) -> None:
-        answer = self.backend.check(self._member(a), self.states, self.timeout)
+        answer = self._decide(self._member(a))
         if answer.status is Status.UNSAT:
             self.context.error(f"{a.text} is empty: no point satisfies its description",
                                a.span)
