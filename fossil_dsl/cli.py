@@ -16,6 +16,7 @@ from rich.console import Console
 
 from fossil_dsl.version import __version__
 from fossil_dsl.api import CheckResult, check_file, synthesise
+from fossil_dsl.diagnostics import error
 from fossil_dsl.plan import CompileError, compile_spec, loss_text, plan_text, symbolic_queries
 from fossil_dsl.result import summary_text, write_artefacts
 from fossil_dsl.smt.registry import BackendUnavailable
@@ -59,7 +60,7 @@ def command_run(args: argparse.Namespace) -> int:
     try:
         outcome = synthesise(result.spec, progress=progress, **overrides)
     except (CompileError, BackendUnavailable) as exc:
-        err.print(f"{args.spec}: error: {exc}", style="red", markup=False)
+        _compile_error(exc, result, err)
         return EXIT_BAD_SPEC
     if args.output:
         write_artefacts(outcome, args.output)
@@ -69,6 +70,11 @@ def command_run(args: argparse.Namespace) -> int:
         style = "bold green" if outcome.certified else "bold red"
         out.print(summary_text(outcome), style=style if args.quiet else None, markup=False)
     return outcome.exit_code
+
+
+def _compile_error(exc: Exception, result: CheckResult, err: Console) -> None:
+    diagnostic = exc.diagnostic() if isinstance(exc, CompileError) else error(str(exc))
+    err.print(diagnostic.render(result.source), style="red", markup=False)
 
 
 def _progress_printer(err: Console):
@@ -89,7 +95,7 @@ def command_compile(args: argparse.Namespace) -> int:
     try:
         plan = compile_spec(result.spec, verifier=args.verifier)
     except (CompileError, BackendUnavailable) as exc:
-        err.print(f"{args.spec}: error: {exc}", style="red", markup=False)
+        _compile_error(exc, result, err)
         return EXIT_BAD_SPEC
     if args.emit == "plan" or args.explain:
         out.print(plan_text(plan), markup=False)

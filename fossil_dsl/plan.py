@@ -8,7 +8,7 @@ from typing import Mapping
 
 from fossil_dsl.certificates import Certificate, Condition, LearnedFunction, certificate_for
 from fossil_dsl.certificates.base import UnsupportedProperty
-from fossil_dsl.diagnostics import FslError
+from fossil_dsl.diagnostics import Diagnostic, FslError, Span, error
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
@@ -21,7 +21,14 @@ DEFAULT_SAMPLES = 1000
 
 
 class CompileError(FslError):
-    pass
+    """A checked spec that cannot be compiled; `span` points at the spec element."""
+
+    def __init__(self, message: str, span: Span | None = None):
+        super().__init__(message)
+        self.span = span
+
+    def diagnostic(self) -> Diagnostic:
+        return error(str(self), self.span)
 
 
 @dataclass(frozen=True)
@@ -59,10 +66,13 @@ def compile_spec(spec: CheckedSpec, **overrides) -> Plan:
     try:
         certificate = certificate_for(spec)
     except UnsupportedProperty as exc:
-        raise CompileError(str(exc)) from None
+        raise CompileError(str(exc), spec.spans.get("prove")) from None
     if spec.inputs:
-        raise CompileError("controller synthesis (a spec with `input`) is not available yet")
+        raise CompileError("controller synthesis (a spec with `input`) is not available yet",
+                           spec.spans.get(f"input:{spec.inputs[0]}"))
     functions = certificate.functions()
+    for function in functions:
+        _check_candidate(spec, function)
     conditions = certificate.conditions()
     verifier, reason = choose_verifier(spec, functions, overrides.pop("verifier", None))
     options = _options(spec, overrides)
@@ -70,6 +80,20 @@ def compile_spec(spec: CheckedSpec, **overrides) -> Plan:
     samples = {role: spec.synthesis.samples.count(role, DEFAULT_SAMPLES) for role in roles}
     return Plan(spec, certificate, functions, conditions, verifier, reason,
                 MappingProxyType(samples), options)
+
+
+def _check_candidate(spec: CheckedSpec, function: LearnedFunction) -> None:
+    """A given function must vanish at the origin where the certificate needs it to
+    (learned networks do by construction)."""
+    if function.candidate is None or not function.zero_at_origin:
+        return
+    try:
+        at_origin = E.substitute(function.candidate, {s: E.ZERO for s in spec.states})
+    except E.ExprError as exc:
+        at_origin = exc
+    if at_origin != E.ZERO:
+        raise CompileError(f"the candidate {function.name} must be 0 at the origin, but "
+                           f"{function.name}(0) = {at_origin}", spec.spans.get("option:candidate"))
 
 
 def _options(spec: CheckedSpec, overrides: dict) -> RunOptions:
@@ -97,15 +121,16 @@ def is_polynomial_problem(spec: CheckedSpec, functions) -> bool:
 
 
 def choose_verifier(spec: CheckedSpec, functions, requested: str | None) -> tuple[str, str]:
+    span = None if requested else spec.spans.get("option:verifier")
     requested = requested or spec.synthesis.verifier
     if requested:
         if requested not in registry.BACKENDS:
             raise CompileError(f"unknown verifier `{requested}`; the verifiers are: "
-                               + ", ".join(registry.names()))
+                               + ", ".join(registry.names()), span)
         if not registry.is_installed(requested):
             available = [n for n in registry.names() if registry.is_installed(n)]
             raise CompileError(f"verifier `{requested}` is not available here; available: "
-                               + ", ".join(available))
+                               + ", ".join(available), span)
         return requested, "named in the spec or on the command line"
     if is_polynomial_problem(spec, functions):
         return "z3", "the problem is polynomial arithmetic, which Z3 decides completely"

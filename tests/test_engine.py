@@ -223,3 +223,16 @@ def test_unsupported_property_or_controller_is_a_clear_error(tmp_path):
     run = subprocess.run([str(FOSSILC), str(path)], capture_output=True, text=True, timeout=120)
     assert run.returncode == 2
     assert "not available yet" in run.stderr and "Traceback" not in run.stderr
+    assert f"{path}:2:7: error: controller synthesis" in run.stderr
+
+
+def test_candidate_must_vanish_at_the_origin(tmp_path):
+    from fossil_dsl.plan import CompileError
+    spec = spec_text(LINEAR + "synthesis { candidate: x0^2 + x1^2 + 1 }\n")
+    with pytest.raises(CompileError, match=r"must be 0 at the origin, but V\(0\) = 1"):
+        fossil_dsl.synthesise(spec)
+    path = tmp_path / "shifted.fsl"
+    path.write_text(LINEAR + "synthesis { candidate: x0^2 + x1^2 + 1 }\n")
+    run = subprocess.run([str(FOSSILC), str(path)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2
+    assert f"{path}:8:13: error: the candidate V must be 0 at the origin" in run.stderr

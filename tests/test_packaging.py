@@ -30,6 +30,13 @@ def test_wheel_contains_grammar_and_entry_point(wheel):
     assert "fossilc = fossil_dsl.cli:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
 
 
+def test_wheel_contains_every_module(wheel):
+    names = set(zipfile.ZipFile(wheel).namelist())
+    package = ROOT / "fossil_dsl"
+    modules = {f"fossil_dsl/{p.relative_to(package)}" for p in package.rglob("*.py")}
+    assert modules <= names, f"missing from the wheel: {sorted(modules - names)}"
+
+
 def test_installed_wheel_parses_outside_the_source_tree(wheel, tmp_path):
     site = tmp_path / "site"
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target",
