@@ -50,3 +50,16 @@ def test_installed_wheel_parses_outside_the_source_tree(wheel, tmp_path):
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stderr
     assert "stability (Lyapunov), 1 state, 0 inputs, continuous time" in run.stdout
+
+
+def test_runs_from_a_source_checkout():
+    """`python` started in the repository imports the source tree, where the grammar
+    lives in grammar/ rather than in the package: it must still be found."""
+    script = ("import fossil_dsl, sys; assert fossil_dsl.__file__.startswith(sys.argv[1]); "
+              "print(fossil_dsl.check_text('state x\\ndynamics continuous { x\\' = -x }\\n"
+              "domain ball([0], 1)\\nprove stable\\n').ok)")
+    run = subprocess.run([sys.executable, "-c", script, str(ROOT)], cwd=ROOT,
+                         env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"},
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == "True"

@@ -119,10 +119,16 @@ def _unclosed(token: Token):
                  token_span(token))
 
 
+def _grammar_text() -> str:
+    try:
+        return resources.files("fossil_dsl.grammar").joinpath("fsl.lark").read_text("utf-8")
+    except ModuleNotFoundError:  # a source checkout on sys.path, not installed
+        return (Path(__file__).resolve().parents[2] / "grammar" / "fsl.lark").read_text("utf-8")
+
+
 @functools.cache
 def _lark() -> Lark:
-    grammar = resources.files("fossil_dsl.grammar").joinpath("fsl.lark").read_text("utf-8")
-    parser = Lark(grammar, parser="lalr", lexer="contextual", postlex=BracketTracker(),
+    parser = Lark(_grammar_text(), parser="lalr", lexer="contextual", postlex=BracketTracker(),
                   propagate_positions=True, maybe_placeholders=True,
                   start=["start", "formula"])
     parser.options.postlex.keywords = {
