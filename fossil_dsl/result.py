@@ -78,10 +78,14 @@ class Result:
             "verifier": plan.verifier,
             "iterations": self.iterations,
             "seed": plan.options.seed,
-            "seconds": {"learn": round(self.learn_seconds, 3),
-                        "verify": round(self.verify_seconds, 3),
-                        "total": round(self.total_seconds, 3)},
+            "seconds": {"learn": _seconds(self.learn_seconds),
+                        "verify": _seconds(self.verify_seconds),
+                        "total": _seconds(self.total_seconds)},
         }
+
+
+def _seconds(value: float) -> float:
+    return float(f"{value:.3f}")
 
 
 def _condition_json(report: ConditionReport) -> dict:

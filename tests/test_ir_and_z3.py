@@ -102,8 +102,23 @@ def test_enclosure_contains_the_true_value(func, value):
     mpmath.mp.dps = 50
     exact = getattr(mpmath, {"abs": "fabs"}.get(func, func))(mpmath.mpf(value.numerator) /
                                                               value.denominator)
-    interval = enclose(E.Apply(func, E.Num(value)))
-    assert interval.lb() <= exact <= interval.ub()
+    low, high = enclose(E.Apply(func, E.Num(value)))
+    assert low <= exact <= high
+
+
+def test_enclosures_round_outwards_and_leave_the_rounding_mode_alone():
+    import ctypes
+    import ctypes.util
+    libm = ctypes.CDLL(ctypes.util.find_library("m"))
+    before = libm.fegetround()
+    third = E.Div(E.ONE, num(3))  # built without folding: codac divides 1 by 3
+    low, high = enclose(third)
+    assert Fraction(low) < Fraction(1, 3) < Fraction(high)
+    tenths = E.Add((num("0.1"), E.Apply("abs", num("0.2"))))
+    low, high = enclose(tenths)
+    assert Fraction(low) <= Fraction(3, 10) <= Fraction(high) and low < high
+    assert libm.fegetround() == before
+    assert repr(float("0.011")) == "0.011"
 
 
 def test_sign_of_irrational_constants():

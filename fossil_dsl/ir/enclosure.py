@@ -1,23 +1,60 @@
 """Sound enclosures of closed expressions (no variables), by codac's outward-rounded
 interval arithmetic. Used to compare constants such as pi/2 or sqrt(2) exactly enough
 to decide a sign, and to bound them for solvers without those functions.
+
+codac (IBEX) rounds outwards only while the processor rounds upwards: importing it
+switches the whole process to upward rounding, and its + - * / give point intervals
+that miss the true value if anything switches back. So codac is imported lazily, and
+every computation with it runs under `upward_rounding()`, which sets the mode codac
+chose and restores the caller's afterwards (the rest of the process keeps rounding to
+nearest, as Python, numpy and torch expect).
 """
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import ctypes.util
+import functools
 import math
 from fractions import Fraction
 
-import codac
-
 from fossil_dsl.ir import expr as E
 
-_FUNCTIONS = {"sin": codac.sin, "cos": codac.cos, "tan": codac.tan, "exp": codac.exp,
-              "log": codac.log, "sqrt": codac.sqrt, "tanh": codac.tanh,
-              "atan": codac.atan, "abs": codac.abs}
+@functools.cache
+def _libm():
+    path = ctypes.util.find_library("m")
+    if path is None:
+        raise RuntimeError("cannot find the C maths library to control rounding modes")
+    return ctypes.CDLL(path)
 
 
-def rational_interval(value: Fraction) -> codac.Interval:
-    """The smallest double interval containing an exact rational."""
+@functools.cache
+def _codac():
+    """The codac module, and the rounding mode it needs (read when it is imported)."""
+    libm = _libm()
+    previous = libm.fegetround()
+    import codac
+    mode = libm.fegetround()
+    libm.fesetround(previous)
+    return codac, mode
+
+
+@contextlib.contextmanager
+def upward_rounding():
+    codac, mode = _codac()
+    libm = _libm()
+    previous = libm.fegetround()
+    libm.fesetround(mode)
+    try:
+        yield codac
+    finally:
+        libm.fesetround(previous)
+
+
+def rational_interval(value: Fraction):
+    """The smallest double interval containing an exact rational (call under
+    upward_rounding)."""
+    codac = _codac()[0]
     near = float(value) if abs(value) < Fraction(10) ** 300 else math.copysign(math.inf, value)
     low = near if Fraction(near) <= value else math.nextafter(near, -math.inf)
     high = near if Fraction(near) >= value else math.nextafter(near, math.inf)
@@ -26,38 +63,49 @@ def rational_interval(value: Fraction) -> codac.Interval:
     return codac.Interval(low, high)
 
 
-def enclose(expr: E.Expr) -> codac.Interval:
-    """An interval containing the exact value of a variable-free expression."""
+def enclose(expr: E.Expr) -> tuple[float, float]:
+    """(low, high) floats containing the exact value of a variable-free expression;
+    low > high means the value is undefined (e.g. log of a negative number)."""
+    with upward_rounding():
+        interval = _enclose(expr)
+        if interval.is_empty():
+            return (math.inf, -math.inf)
+        return (interval.lb(), interval.ub())
+
+
+def _enclose(expr: E.Expr):
+    codac = _codac()[0]
     if isinstance(expr, E.Num):
         return rational_interval(expr.value)
     if isinstance(expr, E.Pi):
         return codac.Interval.pi()
     if isinstance(expr, E.Neg):
-        return -enclose(expr.operand)
+        return -_enclose(expr.operand)
     if isinstance(expr, E.Add):
         return _fold(expr.terms, lambda a, b: a + b)
     if isinstance(expr, E.Mul):
         return _fold(expr.factors, lambda a, b: a * b)
     if isinstance(expr, E.Div):
-        return enclose(expr.numerator) / enclose(expr.denominator)
+        return _enclose(expr.numerator) / _enclose(expr.denominator)
     if isinstance(expr, E.Pow):
-        return _power(enclose(expr.base), expr.exponent)
+        return _power(_enclose(expr.base), expr.exponent)
     if isinstance(expr, E.Apply):
-        return _FUNCTIONS[expr.func](enclose(expr.arg))
+        return getattr(codac, expr.func)(_enclose(expr.arg))
     raise ValueError(f"cannot enclose {expr!r}: it has variables")
 
 
 def _fold(items, combine):
-    result = enclose(items[0])
+    result = _enclose(items[0])
     for item in items[1:]:
-        result = combine(result, enclose(item))
+        result = combine(result, _enclose(item))
     return result
 
 
-def _power(base: codac.Interval, exponent: E.Expr) -> codac.Interval:
+def _power(base, exponent: E.Expr):
+    codac = _codac()[0]
     if isinstance(exponent, E.Num) and exponent.value.denominator == 1:
         return codac.pow(base, int(exponent.value))
-    return codac.exp(enclose(exponent) * codac.log(base))
+    return codac.exp(_enclose(exponent) * codac.log(base))
 
 
 def sign(expr: E.Expr) -> int | None:
@@ -66,19 +114,19 @@ def sign(expr: E.Expr) -> int | None:
         return (expr.value > 0) - (expr.value < 0)
     if E.free_vars(expr):
         return None
-    interval = enclose(expr)
-    if interval.is_empty():
+    low, high = enclose(expr)
+    if low > high:
         return None
-    if interval.lb() > 0:
+    if low > 0:
         return 1
-    if interval.ub() < 0:
+    if high < 0:
         return -1
     return None
 
 
 def bounds(expr: E.Expr) -> tuple[Fraction, Fraction] | None:
     """Exact rational bounds of a closed expression, or None if unbounded."""
-    interval = enclose(expr)
-    if interval.is_empty() or math.isinf(interval.lb()) or math.isinf(interval.ub()):
+    low, high = enclose(expr)
+    if low > high or math.isinf(low) or math.isinf(high):
         return None
-    return Fraction(interval.lb()), Fraction(interval.ub())
+    return Fraction(low), Fraction(high)

@@ -21,11 +21,11 @@ Bounds = tuple[tuple[float, ...], tuple[float, ...]]
 
 
 def _low(value: Expr) -> float:
-    return enclose(value).lb()
+    return enclose(value)[0]
 
 
 def _high(value: Expr) -> float:
-    return enclose(value).ub()
+    return enclose(value)[1]
 
 
 def _hull(a: Bounds | None, b: Bounds | None) -> Bounds | None:
