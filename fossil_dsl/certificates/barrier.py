@@ -1,8 +1,8 @@
 """Barrier certificates: safety (trajectories from I never enter U)."""
 from __future__ import annotations
 
-from fossil_dsl.certificates.base import (Certificate, Condition, LearnedFunction,
-                                          change_of, level_set, register, value_of)
+from fossil_dsl.certificates.base import (Certificate, Condition, change_of, level_set,
+                                          register, value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import Layer
@@ -14,10 +14,7 @@ class Barrier(Certificate):
     title = "barrier certificate"
 
     def functions(self):
-        options = self.spec.synthesis
-        layers = options.certificate or (Layer("square", 10),)
-        return (LearnedFunction("B", layers, zero_at_origin=False,
-                                candidate=options.candidate),)
+        return (self.first_function("B", (Layer("square", 10),), zero_at_origin=False),)
 
     def conditions(self):
         B, dB = value_of("B"), change_of("B")

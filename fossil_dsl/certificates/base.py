@@ -72,6 +72,13 @@ class Certificate:
     def functions(self) -> tuple[LearnedFunction, ...]:
         raise NotImplementedError
 
+    def first_function(self, name: str, default: tuple[Layer, ...],
+                       zero_at_origin: bool) -> LearnedFunction:
+        """The function that `certificate:` (or `candidate:`) in the spec describes."""
+        options = self.spec.synthesis
+        return LearnedFunction(name, options.certificate or default, zero_at_origin,
+                               options.candidate)
+
     def conditions(self) -> tuple[Condition, ...]:
         raise NotImplementedError
 

@@ -1,8 +1,7 @@
 """Lyapunov functions: stability of the origin on the domain."""
 from __future__ import annotations
 
-from fossil_dsl.certificates.base import (Certificate, Condition, LearnedFunction,
-                                          change_of, register, value_of)
+from fossil_dsl.certificates.base import Certificate, Condition, change_of, register, value_of
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import Layer
@@ -14,10 +13,7 @@ class Lyapunov(Certificate):
     title = "Lyapunov function"
 
     def functions(self):
-        options = self.spec.synthesis
-        layers = options.certificate or (Layer("square", 8),)
-        return (LearnedFunction("V", layers, zero_at_origin=True,
-                                candidate=options.candidate),)
+        return (self.first_function("V", (Layer("square", 8),), zero_at_origin=True),)
 
     def conditions(self):
         domain = self.spec.domain
