@@ -21,7 +21,7 @@ from fossil_dsl.plan import CompileError, compile_spec, loss_text, plan_text, sy
 from fossil_dsl.result import summary_text, write_artefacts
 from fossil_dsl.smt.registry import BackendUnavailable
 
-EXIT_OK, EXIT_NOT_CERTIFIED, EXIT_BAD_SPEC, EXIT_INTERNAL = 0, 1, 2, 3
+EXIT_OK, EXIT_BAD_SPEC, EXIT_INTERNAL = 0, 2, 3  # 1 (not certified) comes from the result
 
 
 def _consoles() -> tuple[Console, Console]:

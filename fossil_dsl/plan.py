@@ -134,9 +134,9 @@ def choose_verifier(spec: CheckedSpec, functions, requested: str | None) -> tupl
         return requested, "named in the spec or on the command line"
     if is_polynomial_problem(spec, functions):
         return "z3", "the problem is polynomial arithmetic, which Z3 decides completely"
-    for name in ("dreal", "interval", "cvc5"):
-        if registry.is_installed(name):
-            return name, f"the problem has transcendental functions; {name} handles them"
+    for info in sorted(registry.BACKENDS.values(), key=lambda b: b.rank):
+        if info.transcendental and registry.is_installed(info.name):
+            return info.name, f"the problem has transcendental functions; {info.summary}"
     raise CompileError("no installed verifier handles transcendental functions")
 
 

@@ -74,7 +74,7 @@ class Checker:
             return None
         prop, form = checked
         options = self.check_option_use(options, given, form)
-        self.prove_facts(form, prop, named, domain, dynamics, equation_spans, time)
+        self.prove_facts(form, prop, domain, dynamics, equation_spans, time)
         self.warn_unused()
         if has_errors(self.context.diagnostics):
             return None
@@ -231,7 +231,7 @@ class Checker:
                                  "to verify", self.spans["option:certificate"])
         return options
 
-    def prove_facts(self, form, prop, named, domain, dynamics, equation_spans, time) -> None:
+    def prove_facts(self, form, prop, domain, dynamics, equation_spans, time) -> None:
         prover = RelationProver(self.context, self.context.states, Z3Backend())
         prover.nonempty(Subject(domain, "the domain", self.spans.get("domain")))
         for value in {id(v): v for v in prop.roles.values()}.values():

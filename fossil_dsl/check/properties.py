@@ -28,7 +28,6 @@ Relation = tuple[str, str, str]
 @dataclass(frozen=True)
 class PropertyForm:
     name: str
-    short: str
     certificate: str
     pattern: str
     needs_initial: bool = True
@@ -49,28 +48,28 @@ class PropertyForm:
 _INTERIOR = (("inside_interior", "initial", "safe"), ("inside_interior", "goal", "safe"))
 
 FORMS: list[PropertyForm] = [
-    PropertyForm("stability", "stability", "Lyapunov", "stable", needs_initial=False,
+    PropertyForm("stability", "Lyapunov", "stable", needs_initial=False,
                  stable_type=True),
-    PropertyForm("region of attraction", "ROA", "ROA", "stable", stable_type=True,
+    PropertyForm("region of attraction", "ROA", "stable", stable_type=True,
                  relations=(("inside", "initial", "domain"),)),
-    PropertyForm("safety", "safety", "barrier", "always not U",
+    PropertyForm("safety", "barrier", "always not U",
                  relations=(("inside", "initial", "domain"), ("disjoint", "initial", "unsafe"))),
-    PropertyForm("stable while avoid", "SWA", "ROA + barrier", "stable and always not U",
+    PropertyForm("stable while avoid", "ROA + barrier", "stable and always not U",
                  stable_type=True, max_iters=100, functions=2,
                  relations=(("inside", "initial", "domain"), ("disjoint", "initial", "unsafe"))),
-    PropertyForm("reach while avoid", "RWA", "reach-while-avoid", "not U until G",
+    PropertyForm("reach while avoid", "reach-while-avoid", "not U until G",
                  relations=_INTERIOR, origin_roles=("goal",)),
-    PropertyForm("reach and stay while avoid", "RSWA", "RWA + stay level set",
+    PropertyForm("reach and stay while avoid", "RWA + stay level set",
                  "not U until always F",
                  relations=(("inside_interior", "initial", "safe"),
                             ("disjoint", "final", "unsafe")),
                  origin_roles=("final",)),
-    PropertyForm("reach-avoid-remain", "RAR", "RWA + barrier", "not U until (G and always F)",
+    PropertyForm("reach-avoid-remain", "RWA + barrier", "not U until (G and always F)",
                  max_iters=100, functions=2,
                  relations=_INTERIOR + (("inside", "goal", "final"),
                                         ("disjoint", "final", "unsafe")),
                  origin_roles=("goal", "final")),
-    PropertyForm("reach", "reach", "RWA with the safe set = the domain", "eventually G",
+    PropertyForm("reach", "RWA with the safe set = the domain", "eventually G",
                  relations=_INTERIOR, origin_roles=("goal",)),
 ]
 
@@ -78,10 +77,6 @@ FORMS: list[PropertyForm] = [
 def register_form(form: PropertyForm) -> None:
     """Add a property form (for user-defined certificates); later forms win ties."""
     FORMS.insert(0, form)
-
-
-def form_named(name: str) -> PropertyForm:
-    return next(form for form in FORMS if form.name == name)
 
 
 # ---- normal form: nested tuples ------------------------------------------------------

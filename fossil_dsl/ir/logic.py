@@ -5,9 +5,6 @@ from dataclasses import dataclass
 
 from fossil_dsl.ir.expr import Expr, free_vars as expr_free_vars, substitute as expr_substitute
 
-RELATIONS = ("<=", "<", ">=", ">")
-
-
 class Formula:
     def __and__(self, other): return conjunction(self, other)
     def __or__(self, other): return disjunction(self, other)

@@ -281,8 +281,3 @@ class Named(SetExpr):
     def text(self):
         return self.name
 
-
-def unwrap(value: SetExpr) -> SetExpr:
-    while isinstance(value, Named):
-        value = value.value
-    return value

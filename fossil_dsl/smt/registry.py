@@ -18,17 +18,18 @@ class BackendInfo:
     requires: str  # the Python package the backend needs
     transcendental: bool  # can decide sin, exp, ... (possibly delta-complete)
     summary: str
+    rank: int  # preference among backends for transcendental problems (lower first)
 
 
 BACKENDS: dict[str, BackendInfo] = {b.name: b for b in (
     BackendInfo("z3", "fossil_dsl.smt.z3_backend", "Z3Backend", "z3", False,
-                "Z3, complete for polynomial real arithmetic"),
+                "Z3, complete for polynomial real arithmetic", 9),
     BackendInfo("cvc5", "fossil_dsl.smt.cvc5_backend", "Cvc5Backend", "cvc5", True,
-                "CVC5, polynomial arithmetic and some transcendental queries"),
+                "CVC5, polynomial arithmetic and some transcendental queries", 3),
     BackendInfo("dreal", "fossil_dsl.smt.dreal_backend", "DrealBackend", "dreal", True,
-                "dReal, delta-complete for transcendental functions (optional)"),
+                "dReal, delta-complete for transcendental functions (optional)", 1),
     BackendInfo("interval", "fossil_dsl.smt.interval_backend", "IntervalBackend", "codac",
-                True, "a delta-decision procedure on outward-rounded interval arithmetic"),
+                True, "a delta-decision procedure on outward-rounded interval arithmetic", 2),
 )}
 
 
