@@ -56,7 +56,7 @@ def command_run(args: argparse.Namespace) -> int:
         return EXIT_BAD_SPEC
     progress = None if (args.quiet or args.json) else _progress_printer(err)
     overrides = {"verifier": args.verifier, "seed": args.seed, "max_iters": args.max_iters,
-                 "timeout": args.timeout}
+                 "timeout": args.timeout, "learn_only": args.learn_only or None}
     try:
         outcome = synthesise(result.spec, progress=progress, **overrides)
     except (CompileError, BackendUnavailable) as exc:
@@ -98,7 +98,7 @@ def command_compile(args: argparse.Namespace) -> int:
         _compile_error(exc, result, err)
         return EXIT_BAD_SPEC
     if args.emit == "plan" or args.explain:
-        out.print(plan_text(plan), markup=False)
+        out.print(plan_text(plan, explain=args.explain), markup=False)
     if args.emit == "smt2":
         for name, script in symbolic_queries(plan).items():
             out.print(script, markup=False)
@@ -120,6 +120,9 @@ def _run_parser() -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, help="random seed (the same seed, the same run)")
     parser.add_argument("--max-iters", type=int, help="CEGIS iterations before giving up")
     parser.add_argument("--timeout", type=float, help="seconds for the whole run")
+    parser.add_argument("--learn-only", action="store_true",
+                        help="train without verifying; report how many fresh samples "
+                        "violate each condition (nothing is proved)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress, errors only")
     parser.add_argument("--json", action="store_true", help="print result.json on stdout")
     parser.add_argument("--version", action="version", version=f"fossilc {__version__}")

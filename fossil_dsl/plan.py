@@ -6,14 +6,15 @@ from dataclasses import dataclass, replace
 from types import MappingProxyType
 from typing import Mapping
 
-from fossil_dsl.certificates import Certificate, Condition, LearnedFunction, certificate_for
+from fossil_dsl.certificates import (Certificate, Condition, LearnedFunction, Level,
+                                     certificate_for)
 from fossil_dsl.certificates.base import UnsupportedProperty
 from fossil_dsl.diagnostics import Diagnostic, FslError, Span, error
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.activations import ACTIVATIONS
-from fossil_dsl.ir.spec import CheckedSpec
+from fossil_dsl.ir.spec import CheckedSpec, Layer, TimeDomain
 from fossil_dsl.smt import registry
 from fossil_dsl.smt.smtlib import query_text
 
@@ -42,6 +43,17 @@ class RunOptions:
     query_timeout: float = 60.0  # seconds per verifier query
     learn_steps: int = 1000  # gradient steps per CEGIS iteration at most
     counterexample_neighbours: int = 20
+    control_weight: float = 0.1  # of the control loss (f(x) pointing towards the origin)
+    learn_only: bool = False  # train, measure violations on fresh samples, prove nothing
+
+
+@dataclass(frozen=True)
+class ControllerPlan:
+    """u = k(x): a network from the states to the inputs, substituted into the dynamics."""
+
+    inputs: tuple[str, ...]
+    layers: tuple[Layer, ...]
+    zero_at_origin: bool  # k(0) = 0, so the closed loop keeps the equilibrium
 
 
 @dataclass(frozen=True)
@@ -50,9 +62,11 @@ class Plan:
     certificate: Certificate
     functions: tuple[LearnedFunction, ...]
     conditions: tuple[Condition, ...]
+    levels: tuple[Level, ...]
+    controller: ControllerPlan | None
     verifier: str
     verifier_reason: str
-    samples: Mapping[str, int]  # role -> number of samples
+    samples: Mapping[str, int]  # condition name -> number of training samples
     options: RunOptions
 
     @property
@@ -60,26 +74,55 @@ class Plan:
         return self.spec.states
 
 
-def compile_spec(spec: CheckedSpec, **overrides) -> Plan:
+def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None,
+                 **overrides) -> Plan:
     """The plan for a checked spec; `overrides` (verifier, seed, max_iters, timeout, ...)
-    take precedence over the synthesis block, as command-line options do."""
-    try:
-        certificate = certificate_for(spec)
-    except UnsupportedProperty as exc:
-        raise CompileError(str(exc), spec.spans.get("prove")) from None
-    if spec.inputs:
-        raise CompileError("controller synthesis (a spec with `input`) is not available yet",
-                           spec.spans.get(f"input:{spec.inputs[0]}"))
-    functions = certificate.functions()
+    take precedence over the synthesis block, as command-line options do. `certificate`
+    replaces the registered rule for the spec's property (a user-defined one)."""
+    rule = _certificate(spec, certificate)
+    functions = rule.functions()
     for function in functions:
         _check_candidate(spec, function)
-    conditions = certificate.conditions()
-    verifier, reason = choose_verifier(spec, functions, overrides.pop("verifier", None))
+    conditions = rule.conditions()
+    controller = _controller(spec, rule)
+    verifier, reason = choose_verifier(spec, functions, controller,
+                                       overrides.pop("verifier", None))
     options = _options(spec, overrides)
-    roles = {c.samples for c in conditions}
-    samples = {role: spec.synthesis.samples.count(role, DEFAULT_SAMPLES) for role in roles}
-    return Plan(spec, certificate, functions, conditions, verifier, reason,
-                MappingProxyType(samples), options)
+    samples = {c.name: _sample_count(spec, c.region) for c in conditions}
+    return Plan(spec, rule, functions, conditions, tuple(rule.levels()), controller,
+                verifier, reason, MappingProxyType(samples), options)
+
+
+def _certificate(spec: CheckedSpec, given: type[Certificate] | None) -> Certificate:
+    try:
+        rule = given(spec) if given is not None else certificate_for(spec)
+    except UnsupportedProperty as exc:
+        raise CompileError(str(exc), spec.spans.get("prove")) from None
+    if spec.time is TimeDomain.DISCRETE and not rule.discrete_time:
+        raise CompileError(
+            f"{spec.property.form} in discrete time is not supported: the {rule.title} "
+            "is proved sound for continuous time only (docs/certificates.md says why)",
+            spec.spans.get("dynamics"))
+    return rule
+
+
+def _controller(spec: CheckedSpec, rule: Certificate) -> ControllerPlan | None:
+    if not spec.inputs:
+        return None
+    layers = spec.synthesis.controller or (Layer("linear", len(spec.inputs)),)
+    return ControllerPlan(spec.inputs, layers, rule.keeps_equilibrium)
+
+
+def _sample_count(spec: CheckedSpec, region: S.SetExpr) -> int:
+    """`samples: NAME N` counts for the set named NAME, and for its boundary."""
+    counts = spec.synthesis.samples
+    while isinstance(region, S.Boundary):
+        region = region.inner
+    if region is spec.domain:
+        return counts.count("domain", DEFAULT_SAMPLES)
+    name = region.name if isinstance(region, S.Named) else None
+    return counts.count(name, DEFAULT_SAMPLES) if name else \
+        (counts.default or DEFAULT_SAMPLES)
 
 
 def _check_candidate(spec: CheckedSpec, function: LearnedFunction) -> None:
@@ -109,18 +152,21 @@ def _options(spec: CheckedSpec, overrides: dict) -> RunOptions:
     return replace(options, **{k: v for k, v in overrides.items() if v is not None})
 
 
-def is_polynomial_problem(spec: CheckedSpec, functions) -> bool:
+def is_polynomial_problem(spec: CheckedSpec, functions, controller=None) -> bool:
     expressions = list(spec.dynamics) + [f.candidate for f in functions if f.candidate]
     sets = [spec.domain, *spec.sets.values()]
     formulas = [s.contains_formula(spec.states) for s in sets]
     comparisons = [c for f in formulas for c in L.comparisons(f)]
     expressions += [side for c in comparisons for side in (c.left, c.right)]
+    layers = [layer for f in functions if f.candidate is None for layer in f.layers]
+    layers += list(controller.layers) if controller else []
     layers_polynomial = all(ACTIVATIONS[layer.activation].polynomial_degree is not None
-                            for f in functions if f.candidate is None for layer in f.layers)
+                            for layer in layers)
     return layers_polynomial and all(E.is_arithmetic(e) for e in expressions)
 
 
-def choose_verifier(spec: CheckedSpec, functions, requested: str | None) -> tuple[str, str]:
+def choose_verifier(spec: CheckedSpec, functions, controller,
+                    requested: str | None) -> tuple[str, str]:
     span = None if requested else spec.spans.get("option:verifier")
     requested = requested or spec.synthesis.verifier
     if requested:
@@ -132,7 +178,7 @@ def choose_verifier(spec: CheckedSpec, functions, requested: str | None) -> tupl
             raise CompileError(f"verifier `{requested}` is not available here; available: "
                                + ", ".join(available), span)
         return requested, "named in the spec or on the command line"
-    if is_polynomial_problem(spec, functions):
+    if is_polynomial_problem(spec, functions, controller):
         return "z3", "the problem is polynomial arithmetic, which Z3 decides completely"
     for info in sorted(registry.BACKENDS.values(), key=lambda b: b.rank):
         if info.transcendental and registry.is_installed(info.name):
@@ -141,7 +187,7 @@ def choose_verifier(spec: CheckedSpec, functions, requested: str | None) -> tupl
 
 
 # ---- readable forms ---------------------------------------------------------------------
-def plan_text(plan: Plan) -> str:
+def plan_text(plan: Plan, explain: bool = False) -> str:
     spec = plan.spec
     lines = [f"spec {spec.name}: {spec.property.form} ({spec.property.text})",
              f"certificate: {plan.certificate.title}"]
@@ -150,22 +196,33 @@ def plan_text(plan: Plan) -> str:
             "network " + ", ".join(map(str, function.layers))
         origin = f", {function.name}(0) = 0 by construction" if function.zero_at_origin else ""
         lines.append(f"  learn {function.name}: {shape}{origin}")
+    if plan.controller:
+        controller = plan.controller
+        origin = ", k(0) = 0 by construction" if controller.zero_at_origin else ""
+        lines.append(f"  learn controller ({', '.join(controller.inputs)}) = k(x): network "
+                     + ", ".join(map(str, controller.layers)) + f"{origin}; every condition "
+                     "is proved for the closed loop with k's exact formula substituted")
+    for level in plan.levels:
+        lines.append(f"  level {level.text}, chosen at each iteration")
     lines.append("conditions (each proved by showing its negation unsatisfiable):")
     for condition in plan.conditions:
         lines.append(f"  [{condition.name}] {condition.text}")
         lines.append(f"      x ranges over {_set_words(spec, condition.region)}; "
-                     f"trained on samples of {condition.samples}")
+                     f"{plan.samples[condition.name]} training samples")
     lines.append("dynamics (" + spec.time.value + " time):")
     mark = "'" if spec.time.value == "continuous" else ""
     for state, f in zip(spec.states, spec.dynamics):
         left = f"{state}{mark}" if mark else f"next({state})"
         lines.append(f"  {left} = {f}")
-    lines.append("samples: " + ", ".join(f"{role} {n}" for role, n in plan.samples.items()))
     lines.append(f"verifier: {plan.verifier} ({plan.verifier_reason})")
     options = plan.options
     lines.append(f"loop: at most {options.max_iters} iterations, {options.timeout:g} s, "
                  f"seed {options.seed}")
-    lines.append(f"guarantee: {plan.certificate.guarantee()}")
+    if explain:
+        lines.append(f"guarantee, once every condition is proved: "
+                     f"{plan.certificate.guarantee()}")
+        if plan.controller:
+            lines.append("  (for the closed loop with the learned controller)")
     return "\n".join(lines)
 
 
@@ -180,15 +237,21 @@ def loss_text(plan: Plan) -> str:
         else:
             violation = f"({claim.right}) - ({claim.left})"
         shown_margin = f"{margin:g}*|x|^2" if condition.scaled_margin else f"{margin:g}"
-        where = f"samples of {condition.samples}"
+        where = f"samples of {condition.region.text()}"
         if condition.exclude_origin:
             where += ", x != 0"
         if condition.guard != L.TRUE:
             where += f", where {condition.guard} (within a band)"
-        lines.append(f"  [{condition.name}] relu({violation} + {shown_margin}) over {where}")
+        weight = "" if condition.weight == 1 else f"{condition.weight:g} * "
+        lines.append(f"  [{condition.name}] {weight}relu({violation} + {shown_margin}) "
+                     f"over {where}")
+    if plan.controller:
+        lines.append(f"  [control] {plan.options.control_weight:g} * mean of "
+                     "cos(x, f(x, k(x))) over samples of the domain (f should point to 0)")
     lines.append("  ($V is the network's value, $dV its "
-                 + ("one-step difference)" if plan.certificate.discrete
-                    else "derivative along the flow by automatic differentiation)"))
+                 + ("one-step difference" if plan.certificate.discrete
+                    else "derivative along the flow by automatic differentiation")
+                 + (", $beta a level set from the current samples)" if plan.levels else ")"))
     return "\n".join(lines)
 
 
@@ -211,5 +274,6 @@ def symbolic_queries(plan: Plan) -> dict[str, str]:
                     (" is the one-step difference" if plan.certificate.discrete
                      else " is the derivative along the flow")]
         result[condition.name] = query_text(condition.query(plan.states), plan.states,
-                                            functions, comments)
+                                            functions, comments,
+                                            levels={level.name: None for level in plan.levels})
     return result

@@ -20,7 +20,7 @@ SCHEMA_VERSION = 1
 class ConditionReport:
     name: str
     text: str
-    status: str  # "unsat" (proved), "sat" (counterexample), "unknown"
+    status: str  # "unsat" (proved), "sat" (counterexample), "unknown", "not verified"
     reason: str
     counterexample: tuple[Fraction, ...] | None
 
@@ -31,6 +31,8 @@ class Result:
     certified: bool
     reason: str
     formulas: dict[str, E.Expr]
+    controller: dict[str, E.Expr]  # input -> k_i(x); empty without inputs
+    levels: dict[str, Fraction]
     conditions: tuple[ConditionReport, ...]
     obligations: dict[str, str]  # condition name -> SMT-LIB 2 script (unsat = proved)
     iterations: int
@@ -46,10 +48,16 @@ class Result:
     def exit_code(self) -> int:
         return 0 if self.certified else 1
 
+    @property
+    def learn_only(self) -> bool:
+        return self.plan.options.learn_only
+
     def guarantee(self) -> str:
         if not self.certified:
             return "nothing is proved"
-        return self.plan.certificate.guarantee()
+        text = self.plan.certificate.guarantee()
+        return text + (" (for the closed loop with the controller shown)"
+                       if self.controller else "")
 
     def assumptions(self) -> list[str]:
         plan = self.plan
@@ -74,6 +82,9 @@ class Result:
             "guarantee": self.guarantee(),
             "assumptions": self.assumptions() if self.certified else [],
             "functions": {name: str(f) for name, f in self.formulas.items()},
+            "controller": {name: str(f) for name, f in self.controller.items()},
+            "levels": {name: str(v) for name, v in self.levels.items()},
+            "learn_only": self.learn_only,
             "conditions": [_condition_json(c) for c in self.conditions],
             "verifier": plan.verifier,
             "iterations": self.iterations,
@@ -96,28 +107,33 @@ def _condition_json(report: ConditionReport) -> dict:
 
 def build_result(plan: Plan, outcome: CegisOutcome, total_seconds: float) -> Result:
     texts = {c.name: c.text for c in plan.conditions}
-    reports = tuple(ConditionReport(v.condition, texts[v.condition], v.status.value, v.reason,
-                                    v.counterexample) for v in outcome.verdicts)
-    return Result(plan, outcome.certified, outcome.reason, dict(outcome.formulas), reports,
+    reports = tuple(ConditionReport(v.condition, texts[v.condition],
+                                    "not verified" if plan.options.learn_only else v.status.value,
+                                    v.reason, v.counterexample) for v in outcome.verdicts)
+    candidate = outcome.candidate
+    return Result(plan, outcome.certified, outcome.reason, dict(candidate.formulas),
+                  dict(candidate.controller), dict(candidate.levels), reports,
                   obligations(plan, outcome), len(outcome.history), outcome.learn_seconds,
                   outcome.verify_seconds, total_seconds)
 
 
 def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
     """Each condition's query with the certificate as a named, defined function."""
+    candidate = outcome.candidate
     functions = {}
-    for name, formula in outcome.formulas.items():
+    for name, formula in candidate.formulas.items():
         functions[name] = formula
-        functions[f"d{name}"] = outcome.changes[name]
+        functions[f"d{name}"] = candidate.changes[name]
     change = "one-step difference C(f(x)) - C(x)" if plan.certificate.discrete else \
         "derivative along the flow, grad C . f"
+    loop = [f"closed loop with the controller {u} = {k}" for u, k in candidate.controller.items()]
     scripts = {}
     for condition in plan.conditions:
         comments = [f"{plan.spec.name}: condition {condition.name}: {condition.text}",
                     "unsat means the condition holds",
-                    f"each dC below is the {change}, computed exactly from C"]
+                    f"each dC below is the {change}, computed exactly from C", *loop]
         scripts[condition.name] = query_text(condition.query(plan.states), plan.states,
-                                             functions, comments)
+                                             functions, comments, levels=candidate.levels)
     return scripts
 
 
@@ -129,14 +145,22 @@ def summary_text(result: Result) -> str:
         lines.append(f"  why: {result.reason}")
     for name, formula in result.formulas.items():
         lines.append(f"  {name}(x) = {formula}")
+    for name, formula in result.controller.items():
+        lines.append(f"  controller {name} = {formula}")
+    for name, value in result.levels.items():
+        lines.append(f"  level {name} = {value} (≈ {float(value):.6g})")
     for report in result.conditions:
-        mark = {"unsat": "proved", "sat": "fails", "unknown": "unknown"}[report.status]
+        mark = {"unsat": "proved", "sat": "fails", "unknown": "unknown",
+                "not verified": "not verified"}[report.status]
         extra = ""
         if report.counterexample:
             extra = " at (" + ", ".join(format(float(v), ".6g") for v in report.counterexample) + ")"
         elif report.reason:
             extra = f" ({report.reason})"
         lines.append(f"  [{mark}] {report.text}{extra}")
+    if result.learn_only:
+        lines.append("  learn-only: NOTHING WAS PROVED; the rates above are of fresh samples "
+                     "that violate each condition, which no verifier has checked")
     lines.append(f"  guarantee: {result.guarantee()}")
     if result.certified:
         lines += [f"  assumes: {a}" for a in result.assumptions()]

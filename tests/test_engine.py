@@ -216,14 +216,19 @@ def test_run_writes_artefacts_with_o(tmp_path):
     assert (tmp_path / "out" / "obligations" / "decrease.smt2").exists()
 
 
-def test_unsupported_property_or_controller_is_a_clear_error(tmp_path):
-    path = tmp_path / "ctrl.fsl"
-    path.write_text(LINEAR.replace("state x0, x1", "state x0, x1\ninput u").replace(
-        "-x1\n}", "-x1 + u\n}"))
+@pytest.mark.parametrize("prove", ["from init: stable", "from init: safe until goal",
+                                   "from init: eventually goal"])
+def test_discrete_time_without_a_sound_certificate_is_a_clear_error(tmp_path, prove):
+    path = tmp_path / "discrete.fsl"
+    path.write_text("state x0, x1\ndynamics discrete {\n    next(x0) = 0.5*x0\n"
+                    "    next(x1) = 0.5*x1\n}\ndomain box([-1, -1], [1, 1])\n"
+                    "set init = ball([0, 0], 0.5)\nset goal = ball([0, 0], 0.1)\n"
+                    f"set safe = box([-0.9, -0.9], [0.9, 0.9])\nprove {prove}\n")
     run = subprocess.run([str(FOSSILC), str(path)], capture_output=True, text=True, timeout=120)
-    assert run.returncode == 2
-    assert "not available yet" in run.stderr and "Traceback" not in run.stderr
-    assert f"{path}:2:7: error: controller synthesis" in run.stderr
+    assert run.returncode == 2, run.stdout + run.stderr
+    assert "Traceback" not in run.stderr
+    assert f"{path}:2:1: error:" in run.stderr
+    assert "in discrete time is not supported" in run.stderr
 
 
 def test_candidate_must_vanish_at_the_origin(tmp_path):

@@ -167,7 +167,7 @@ def installed_backends():
                 reason=f"verifier {name} is not installed here"))
 
 
-@pytest.mark.parametrize("backend", installed_backends())
+@pytest.mark.parametrize("backend", list(installed_backends()))
 @pytest.mark.parametrize("formula, expected", [c[1:] for c in CONFORMANCE],
                          ids=[c[0] for c in CONFORMANCE])
 def test_backend_conformance(backend, formula, expected):

@@ -7,19 +7,19 @@ formulas that are returned with it.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from fractions import Fraction
 from typing import Callable
 
 import torch
 
-from fossil_dsl.certificates.base import Condition, change_of, value_of
+from fossil_dsl.cegis.learner import Learner
+from fossil_dsl.certificates.base import change_of, level_of, value_of
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.learn.evaluate import evaluate, holds, state_env
 from fossil_dsl.learn.networks import Network
-from fossil_dsl.learn.sampling import around, sample
 from fossil_dsl.plan import Plan
 from fossil_dsl.smt.api import Answer, Backend, Status
 
@@ -49,7 +49,6 @@ class IterationRecord:
 class CegisState:
     """Everything the loop carries from one iteration to the next."""
 
-    samples: dict[str, torch.Tensor]  # condition name -> training points
     iteration: int = 0
     learn_seconds: float = 0.0
     verify_seconds: float = 0.0
@@ -57,24 +56,46 @@ class CegisState:
 
 
 @dataclass(frozen=True)
+class ExactCandidate:
+    """What is verified: exact formulas for every function, the controller and the
+    closed loop, each function's change along it, and the levels as rationals."""
+
+    formulas: dict[str, E.Expr]
+    changes: dict[str, E.Expr]
+    controller: dict[str, E.Expr]  # input name -> k_i(x)
+    closed_loop: tuple[E.Expr, ...]
+    levels: dict[str, Fraction]
+
+    def mapping(self) -> dict[str, E.Expr]:
+        found = {value_of(n).name: f for n, f in self.formulas.items()}
+        found.update({change_of(n).name: c for n, c in self.changes.items()})
+        found.update({level_of(n).name: E.Num(v) for n, v in self.levels.items()})
+        return found
+
+
+@dataclass(frozen=True)
 class CegisOutcome:
     certified: bool
     reason: str
-    formulas: dict[str, E.Expr]  # function name -> exact formula (as verified)
-    changes: dict[str, E.Expr]  # function name -> its derivative / one-step difference
+    candidate: ExactCandidate
     queries: dict[str, L.Formula]  # condition name -> the query decided (substituted)
     verdicts: tuple[Verdict, ...]
     history: tuple[IterationRecord, ...]
     learn_seconds: float
     verify_seconds: float
     networks: dict[str, Network]
+    violation_rates: dict[str, tuple[int, int]] | None = None  # learn-only: (fails, of)
+
+    @property
+    def formulas(self) -> dict[str, E.Expr]:
+        return self.candidate.formulas
 
 
 Progress = Callable[[IterationRecord], None]
 
 
 class Cegis:
-    def __init__(self, plan: Plan, backend: Backend, progress: Progress | None = None):
+    def __init__(self, plan: Plan, backend: Backend | None, progress: Progress | None = None):
         self.plan = plan
         self.backend = backend
         self.progress = progress or (lambda record: None)
@@ -82,9 +103,15 @@ class Cegis:
         self.options = plan.options
         torch.manual_seed(self.options.seed)
         self.generator = torch.Generator().manual_seed(self.options.seed)
-        self.networks = {f.name: Network(len(self.states), f.layers, f.zero_at_origin)
-                         for f in plan.functions if f.candidate is None}
+        self.learner = Learner(plan, self.generator)
         self.deadline = time.monotonic() + self.options.timeout
+
+    @property
+    def networks(self) -> dict[str, Network]:
+        found = dict(self.learner.networks)
+        if self.learner.controller is not None:
+            found["k"] = self.learner.controller
+        return found
 
     # ---- the loop ----
     def run(self) -> CegisOutcome:
@@ -93,149 +120,85 @@ class Cegis:
         threads = torch.get_num_threads()
         torch.set_num_threads(1)
         try:
-            return self._run()
+            return self._learn_only() if self.options.learn_only else self._run()
         finally:
             torch.set_num_threads(threads)
 
     def _run(self) -> CegisOutcome:
-        state = CegisState(self.initial_samples())
-        optimiser = self._optimiser()
+        state = CegisState()
         reason = f"gave up after {self.options.max_iters} iterations"
         for state.iteration in range(1, self.options.max_iters + 1):
-            loss, learn_seconds = self.learn(state, optimiser)
-            formulas, changes = self.exact_formulas()
-            verdicts, queries, verify_seconds = self.verify(formulas, changes)
+            loss, learn_seconds = self.learn(state)
+            candidate = self.exact_candidate()
+            verdicts, queries, verify_seconds = self.verify(candidate)
             state.verify_seconds += verify_seconds
             record = IterationRecord(state.iteration, loss, verdicts, learn_seconds,
                                      verify_seconds)
             state.history.append(record)
             self.progress(record)
             if all(v.status is Status.UNSAT for v in verdicts):
-                return self.outcome(state, True, "every condition proved", formulas,
-                                    changes, queries, verdicts)
-            if not self.networks:
-                return self.outcome(state, False, _failure_reason(verdicts), formulas,
-                                    changes, queries, verdicts)
-            self.learn_from(verdicts, state)
+                return self.outcome(state, True, "every condition proved", candidate,
+                                    queries, verdicts)
+            if not self.learner.trainable:
+                return self.outcome(state, False, _failure_reason(verdicts), candidate,
+                                    queries, verdicts)
+            self.learn_from(verdicts)
             if time.monotonic() > self.deadline:
                 reason = f"timeout after {self.options.timeout:g} s"
                 break
-        return self.outcome(state, False, reason, formulas, changes, queries, verdicts)
+        return self.outcome(state, False, reason, candidate, queries, verdicts)
 
-    def outcome(self, state, certified, reason, formulas, changes, queries, verdicts):
-        return CegisOutcome(certified, reason, formulas, changes, queries, tuple(verdicts),
+    def _learn_only(self) -> CegisOutcome:
+        state = CegisState(iteration=1)
+        loss, learn_seconds = self.learn(state)
+        held_out = torch.Generator().manual_seed(self.options.seed + 1)
+        rates = self.learner.violation_rates(held_out)
+        verdicts = tuple(Verdict(name, Status.UNKNOWN, "not verified (learn-only): "
+                                 f"{fails} of {total} fresh samples violate it")
+                         for name, (fails, total) in rates.items())
+        state.history.append(IterationRecord(1, loss, verdicts, learn_seconds, 0.0))
+        return replace(self.outcome(state, False, "learn-only: trained without verifying; "
+                                    "nothing was proved", self.exact_candidate(), {},
+                                    verdicts), violation_rates=rates)
+
+    def outcome(self, state, certified, reason, candidate, queries, verdicts):
+        return CegisOutcome(certified, reason, candidate, queries, tuple(verdicts),
                             tuple(state.history), state.learn_seconds, state.verify_seconds,
                             self.networks)
 
-    # ---- learning ----
-    def initial_samples(self) -> dict[str, torch.Tensor]:
-        by_role = {}
-        for role, count in self.plan.samples.items():
-            region = self._role_set(role)
-            by_role[role] = sample(region, self.states, count, self.generator,
-                                   self.plan.spec.domain.bounding_box())
-        return {c.name: by_role[c.samples] for c in self.plan.conditions}
-
-    def _role_set(self, role: str):
-        return self.plan.spec.domain if role == "domain" else self.plan.spec.property.role(role)
-
-    def _optimiser(self):
-        self.parameters = [p for n in self.networks.values() for p in n.parameters()]
-        if not self.parameters:
-            return None
-        return torch.optim.Adam(self.parameters, lr=self.options.learning_rate)
-
-    def learn(self, state: CegisState, optimiser) -> tuple[float, float]:
+    def learn(self, state: CegisState) -> tuple[float, float]:
         started = time.monotonic()
-        loss_value = 0.0
-        if optimiser is not None:
-            for _ in range(self.options.learn_steps):
-                loss, satisfied = self.loss(state.samples)
-                loss_value = float(loss.detach())
-                if satisfied or time.monotonic() > self.deadline:
-                    break
-                optimiser.zero_grad()
-                loss.backward()
-                _clip_gradients(self.parameters, 10.0)
-                optimiser.step()
-            for network in self.networks.values():
-                network.round_weights(self.options.digits)
+        loss = 0.0
+        if self.learner.trainable:
+            loss = self.learner.train(self.options.learn_steps, self.deadline)
         elapsed = time.monotonic() - started
         state.learn_seconds += elapsed
-        return loss_value, elapsed
-
-    def loss(self, samples: dict[str, torch.Tensor]) -> tuple[torch.Tensor, bool]:
-        total, satisfied = torch.zeros((), dtype=torch.float64), True
-        for condition in self.plan.conditions:
-            points = samples[condition.name]
-            if condition.exclude_origin:
-                points = points[points.norm(dim=1) > 1e-6]
-            if len(points) == 0:
-                continue
-            term, ok = self.condition_loss(condition, points)
-            total = total + term
-            satisfied = satisfied and ok
-        return total, satisfied
-
-    def condition_loss(self, condition: Condition, points: torch.Tensor):
-        points = points.clone().requires_grad_(True)
-        env = state_env(self.states, points)
-        env.update(self.values(points))
-        violation = _violation(condition.claim, env)
-        margin = self.options.margin
-        if condition.scaled_margin:
-            margin = margin * (points ** 2).sum(1)
-        mask = self._guard_mask(condition.guard, env, len(points))
-        shortfall = torch.relu(violation + margin)[mask]
-        if len(shortfall) == 0:
-            return torch.zeros((), dtype=torch.float64), True
-        return shortfall.mean(), bool((shortfall == 0).all())
-
-    def _guard_mask(self, guard: L.Formula, env, batch: int) -> torch.Tensor:
-        if guard == L.TRUE:
-            return torch.ones(batch, dtype=torch.bool)
-        scale = max((float(v.detach().abs().mean()) for k, v in env.items()
-                     if k.startswith("$") and isinstance(v, torch.Tensor)), default=1.0)
-        return holds(guard, {k: v.detach() for k, v in env.items()}, batch, 0.1 * scale)
-
-    def values(self, points: torch.Tensor) -> dict[str, torch.Tensor]:
-        """Each network's value and its derivative (or one-step difference) at points."""
-        result = {}
-        field = self.field(points)
-        for name, network in self.networks.items():
-            value = network(points)
-            if self.plan.spec.time is TimeDomain.DISCRETE:
-                change = network(torch.stack(field, 1)) - value
-            else:
-                grad, = torch.autograd.grad(value.sum(), points, create_graph=True)
-                change = sum(grad[:, i] * f for i, f in enumerate(field))
-            result[value_of(name).name] = value
-            result[change_of(name).name] = change
-        return result
-
-    def field(self, points: torch.Tensor) -> list[torch.Tensor]:
-        env = state_env(self.states, points)
-        return [torch.as_tensor(evaluate(f, env), dtype=torch.float64).expand(len(points))
-                for f in self.plan.spec.dynamics]
+        return loss, elapsed
 
     # ---- verification ----
-    def exact_formulas(self) -> tuple[dict[str, E.Expr], dict[str, E.Expr]]:
+    def exact_candidate(self) -> ExactCandidate:
+        digits = self.options.digits
+        learner = self.learner
         formulas = {f.name: f.candidate if f.candidate is not None
-                    else self.networks[f.name].formula(self.states, self.options.digits)
+                    else learner.networks[f.name].formula(self.states, digits)
                     for f in self.plan.functions}
-        changes = {name: self.change(formula) for name, formula in formulas.items()}
-        return formulas, changes
+        controller = {}
+        if learner.controller is not None:
+            controller = dict(zip(self.plan.controller.inputs,
+                                  learner.controller.formulas(self.states, digits)))
+        closed_loop = tuple(E.substitute(f, controller) for f in self.plan.spec.dynamics)
+        changes = {name: self.change(formula, closed_loop) for name, formula in formulas.items()}
+        levels = {name: _rational(value, digits) for name, value in learner.levels().items()}
+        return ExactCandidate(formulas, changes, controller, closed_loop, levels)
 
-    def change(self, formula: E.Expr) -> E.Expr:
-        dynamics = self.plan.spec.dynamics
+    def change(self, formula: E.Expr, dynamics) -> E.Expr:
         if self.plan.spec.time is TimeDomain.DISCRETE:
             return E.add(calculus.compose(formula, self.states, dynamics), E.neg(formula))
         return calculus.lie_derivative(formula, self.states, dynamics)
 
-    def verify(self, formulas, changes):
+    def verify(self, candidate: ExactCandidate):
         started = time.monotonic()
-        mapping = {value_of(n).name: f for n, f in formulas.items()}
-        mapping.update({change_of(n).name: c for n, c in changes.items()})
+        mapping = candidate.mapping()
         verdicts, queries = [], {}
         for condition in self.plan.conditions:
             query = L.substitute(condition.query(self.states), mapping)
@@ -245,39 +208,16 @@ class Cegis:
             verdicts.append(_verdict(condition.name, answer, self.states))
         return tuple(verdicts), queries, time.monotonic() - started
 
-    def learn_from(self, verdicts, state: CegisState) -> None:
-        scale = _box_scale(self.plan.spec.domain.bounding_box())
+    def learn_from(self, verdicts) -> None:
         for verdict in verdicts:
-            condition = next(c for c in self.plan.conditions if c.name == verdict.condition)
             if verdict.status is Status.SAT:
-                point = torch.tensor([list(map(float, verdict.counterexample))],
-                                     dtype=torch.float64)
-                extra = around(point, condition.region, self.states,
-                               self.options.counterexample_neighbours, 0.02 * scale,
-                               self.generator)
+                self.learner.add_counterexample(verdict.condition, verdict.counterexample)
             elif verdict.status is Status.UNKNOWN:  # learn something: more samples there
-                extra = sample(condition.region, self.states, 100, self.generator,
-                               self.plan.spec.domain.bounding_box())
-            else:
-                continue
-            state.samples[condition.name] = torch.cat([state.samples[condition.name], extra])
+                self.learner.add_region_samples(verdict.condition)
 
 
-def _clip_gradients(parameters, limit: float) -> None:
-    """Scale gradients down to norm `limit` (torch's clip_grad_norm_ costs ~1.6 ms a call)."""
-    norm = float(sum(p.grad.pow(2).sum() for p in parameters if p.grad is not None)) ** 0.5
-    if norm > limit:
-        for p in parameters:
-            if p.grad is not None:
-                p.grad.mul_(limit / norm)
-
-
-def _violation(claim: L.Formula, env) -> torch.Tensor:
-    """How far the claim is from holding (positive: violated)."""
-    if not isinstance(claim, L.Compare):
-        raise TypeError(f"a claim must be one comparison, not {claim}")
-    difference = evaluate(claim.left, env) - evaluate(claim.right, env)
-    return difference if claim.relation in ("<", "<=") else -difference
+def _rational(value: float, digits: int) -> Fraction:
+    return Fraction(round(value * 10 ** digits), 10 ** digits)
 
 
 def _verdict(name: str, answer: Answer, states) -> Verdict:
@@ -290,9 +230,3 @@ def _failure_reason(verdicts) -> str:
     words = [f"{v.condition}: {'counterexample' if v.status is Status.SAT else v.reason or 'unknown'}"
              for v in failed]
     return "the given function fails: " + "; ".join(words)
-
-
-def _box_scale(box) -> float:
-    if box is None:
-        return 1.0
-    return max(high - low for low, high in zip(*box))

@@ -5,34 +5,48 @@ from fossil_dsl.certificates.base import (Certificate, Condition, change_of, lev
                                           register, value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.sets import SetExpr
 from fossil_dsl.ir.spec import Layer
+
+DEFAULT_LAYERS = (Layer("square", 10),)
+
+
+def barrier_conditions(certificate: Certificate, name: str, inside: SetExpr,
+                       outside: SetExpr, inside_words: str, outside_words: str,
+                       prefix: str = "") -> tuple[Condition, ...]:
+    """name <= 0 on `inside`, > 0 on `outside`, and {name <= 0} cannot be left in D."""
+    B, dB = value_of(name), change_of(name)
+    initial = Condition(f"{prefix}initial", f"{name}(x) <= 0 for every x in {inside_words}",
+                        inside, L.Compare("<=", B, E.ZERO))
+    unsafe = Condition(f"{prefix}unsafe", f"{name}(x) > 0 for every x in {outside_words}",
+                       outside, L.Compare(">", B, E.ZERO))
+    domain = certificate.spec.domain
+    if certificate.discrete:
+        # B(f(x)) - B(x) <= 0 where B(x) <= 0 implies B(f(x)) <= 0: {B <= 0} is invariant
+        flow = Condition(f"{prefix}invariance",
+                         f"{name}(f(x)) <= 0 for every x in D with {name}(x) <= 0", domain,
+                         L.Compare("<=", E.add(dB, B), E.ZERO),
+                         guard=L.Compare("<=", B, E.ZERO))
+    else:
+        flow = Condition(f"{prefix}flow",
+                         f"d{name}/dt < 0 for every x in D with {name}(x) = 0", domain,
+                         L.Compare("<", dB, E.ZERO), guard=level_set(name))
+    return initial, unsafe, flow
 
 
 @register
 class Barrier(Certificate):
     form = "safety"
     title = "barrier certificate"
+    discrete_time = True
+    keeps_equilibrium = False
 
     def functions(self):
-        return (self.first_function("B", (Layer("square", 10),), zero_at_origin=False),)
+        return (self.first_function("B", DEFAULT_LAYERS, zero_at_origin=False),)
 
     def conditions(self):
-        B, dB = value_of("B"), change_of("B")
-        domain = self.spec.domain
-        initial = Condition("initial", "B(x) <= 0 for every x in I", self.role("initial"),
-                            L.Compare("<=", B, E.ZERO), samples="initial")
-        unsafe = Condition("unsafe", "B(x) > 0 for every x in U", self.role("unsafe"),
-                           L.Compare(">", B, E.ZERO), samples="unsafe")
-        if self.discrete:
-            # B(f(x)) - B(x) <= 0 where B(x) <= 0: the set {B <= 0} is invariant
-            flow = Condition("invariance", "B(f(x)) <= 0 for every x in D with B(x) <= 0",
-                             domain, L.Compare("<=", E.add(dB, B), E.ZERO),
-                             guard=L.Compare("<=", B, E.ZERO), samples="domain")
-        else:
-            flow = Condition("flow", "dB/dt < 0 for every x in D with B(x) = 0", domain,
-                             L.Compare("<", dB, E.ZERO), guard=level_set("B"),
-                             samples="domain")
-        return initial, unsafe, flow
+        return barrier_conditions(self, "B", self.role("initial"), self.role("unsafe"),
+                                  "I", "U")
 
     def guarantee(self):
         return ("trajectories from I never enter U while they remain in D: B <= 0 on I, "

@@ -1,8 +1,10 @@
-"""What a certificate rule provides: the functions to learn and the conditions they must
-satisfy, as neutral formulas over placeholders for each function and its derivative.
+"""What a certificate rule provides: the functions to learn, the levels chosen from data,
+and the conditions they must satisfy, as neutral formulas over placeholders.
 
 A condition holds when `region ∧ guard ∧ ¬claim` is unsatisfiable; the placeholders
-`$V` and `$dV` (per function) are replaced by exact formulas only when verifying.
+`$V` and `$dV` (per function) and `$beta` (per level) are replaced by exact formulas and
+numbers only when verifying. The learner's loss is one hinge term per condition, so a
+certificate rule gets its losses from its conditions.
 """
 from __future__ import annotations
 
@@ -27,6 +29,26 @@ def change_of(function: str) -> E.Var:
     return E.Var(f"$d{function}")
 
 
+def level_of(name: str) -> E.Var:
+    """The placeholder for a level (a number chosen from data at each iteration)."""
+    return E.Var(f"${name}")
+
+
+@dataclass(frozen=True)
+class Level:
+    """A number in the conditions, such as the β of a sublevel set {V <= β}, chosen
+    from data at each iteration: halfway between the largest value of `function` on the
+    samples of condition `below` and the smallest on the samples of condition `above`,
+    or, without `below`, as close under that smallest value as the learning margin
+    allows. The verifier then decides the conditions with it."""
+
+    name: str
+    function: str
+    above: str
+    below: str | None = None
+    text: str = ""
+
+
 @dataclass(frozen=True)
 class LearnedFunction:
     name: str  # "V", "B"
@@ -43,8 +65,11 @@ class Condition:
     claim: L.Formula  # must hold there; over states and placeholders
     guard: L.Formula = L.TRUE  # further hypotheses over placeholders (e.g. B(x) = 0)
     exclude_origin: bool = False
-    samples: str = "domain"  # the role whose samples train this condition
     scaled_margin: bool = False  # learn with a margin growing as |x|^2 (near 0)
+    weight: float = 1.0  # of this condition's loss term
+    # the learner may also meet it by making the guard (one comparison) false there,
+    # e.g. by lowering V below a level where V cannot decrease
+    escapable_guard: bool = False
 
     def query(self, states) -> L.Formula:
         """Satisfiable exactly when the condition fails (before substitution)."""
@@ -61,10 +86,16 @@ def level_set(function: str, level: E.Expr = E.ZERO) -> L.Formula:
 
 
 class Certificate:
-    """A certificate rule for one property form."""
+    """A certificate rule for one property form.
+
+    A subclass gives `functions`, `conditions` and `guarantee`, and, where it needs
+    them, `levels`. Registering it (`@register`) makes the compiler use it for `form`.
+    """
 
     form: ClassVar[str]  # the property form it proves (check.properties.FORMS)
     title: ClassVar[str]
+    discrete_time: ClassVar[bool] = False  # its conditions are sound in discrete time
+    keeps_equilibrium: ClassVar[bool] = True  # a controller must keep k(0) = 0
 
     def __init__(self, spec: CheckedSpec):
         self.spec = spec
@@ -79,8 +110,19 @@ class Certificate:
         return LearnedFunction(name, options.certificate or default, zero_at_origin,
                                options.candidate)
 
+    def second_function(self, name: str, default: tuple[Layer, ...],
+                        zero_at_origin: bool) -> LearnedFunction:
+        """The function that `certificate2:` (or `candidate2:`) describes; without
+        `certificate2`, it has the layers of `certificate`."""
+        options = self.spec.synthesis
+        layers = options.certificate2 or options.certificate or default
+        return LearnedFunction(name, layers, zero_at_origin, options.candidate2)
+
     def conditions(self) -> tuple[Condition, ...]:
         raise NotImplementedError
+
+    def levels(self) -> tuple[Level, ...]:
+        return ()
 
     def guarantee(self) -> str:
         raise NotImplementedError
@@ -104,7 +146,8 @@ CERTIFICATES: dict[str, type[Certificate]] = {}
 
 
 def register(cls: type[Certificate]) -> type[Certificate]:
-    """Class decorator: this certificate proves properties of form `cls.form`."""
+    """Class decorator: this certificate proves properties of form `cls.form` (it
+    replaces any certificate registered for that form before)."""
     CERTIFICATES[cls.form] = cls
     return cls
 

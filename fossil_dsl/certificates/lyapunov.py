@@ -11,6 +11,7 @@ from fossil_dsl.ir.spec import Layer
 class Lyapunov(Certificate):
     form = "stability"
     title = "Lyapunov function"
+    discrete_time = True
 
     def functions(self):
         return (self.first_function("V", (Layer("square", 8),), zero_at_origin=True),)

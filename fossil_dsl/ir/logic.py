@@ -162,3 +162,17 @@ def substitute(formula: Formula, mapping) -> Formula:
     if isinstance(formula, Not):
         return negation(substitute(formula.arg, mapping))
     return formula
+
+
+def boundary_outer(formula: Formula) -> Formula:
+    """A closed set containing the boundary of the set that `formula` describes.
+
+    Where no comparison is at equality, every comparison keeps its truth value nearby (for
+    continuous expressions), so the point is not on the boundary; and the boundary lies
+    in the closure. Exact for boxes, balls and ellipsoids.
+    """
+    atoms = {(c.left, c.right): c for c in comparisons(formula)}
+    on_some_atom = disjunction(*(conjunction(Compare("<=", left, right),
+                                             Compare(">=", left, right))
+                                 for left, right in atoms))
+    return conjunction(closed_outer(formula), on_some_atom)

@@ -281,3 +281,21 @@ class Named(SetExpr):
     def text(self):
         return self.name
 
+
+
+@dataclass(frozen=True)
+class Boundary(SetExpr):
+    """∂A, or rather a closed set containing it (see logic.boundary_outer): proving a
+    condition there proves it on the boundary."""
+
+    inner: SetExpr
+
+    def bounding_box(self):
+        return self.inner.bounding_box()
+
+    def membership(self, point):
+        return L.boundary_outer(self.inner.membership(point))
+
+    def text(self):
+        inner = self.inner.text()
+        return f"∂{inner}" if isinstance(self.inner, Named) else f"∂({inner})"

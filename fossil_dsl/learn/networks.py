@@ -12,10 +12,12 @@ from fossil_dsl.ir.spec import Layer
 
 
 class Network(torch.nn.Module):
-    """Hidden layers as given, then one linear output. With `zero_at_origin`, there are no
-    biases and the value at 0 is subtracted, so C(0) = 0 exactly, for any activation."""
+    """Hidden layers as given, then a linear output (one value, or `outputs` values for a
+    controller). With `zero_at_origin`, there are no biases and the value at 0 is
+    subtracted, so C(0) = 0 exactly, for any activation."""
 
-    def __init__(self, inputs: int, layers: Sequence[Layer], zero_at_origin: bool):
+    def __init__(self, inputs: int, layers: Sequence[Layer], zero_at_origin: bool,
+                 outputs: int = 1):
         super().__init__()
         self.activations = [ACTIVATIONS[layer.activation] for layer in layers]
         widths = [inputs] + [layer.width for layer in layers]
@@ -23,7 +25,8 @@ class Network(torch.nn.Module):
         self.linears = torch.nn.ModuleList(
             torch.nn.Linear(a, b, bias=bias, dtype=torch.float64)
             for a, b in zip(widths, widths[1:]))
-        self.output = torch.nn.Linear(widths[-1], 1, bias=bias, dtype=torch.float64)
+        self.output = torch.nn.Linear(widths[-1], outputs, bias=bias, dtype=torch.float64)
+        self.outputs = outputs
         self.zero_at_origin = zero_at_origin
         self.subtract_origin = zero_at_origin and not all(a.zero_at_zero
                                                          for a in self.activations)
@@ -31,7 +34,8 @@ class Network(torch.nn.Module):
     def raw(self, x: torch.Tensor) -> torch.Tensor:
         for linear, activation in zip(self.linears, self.activations):
             x = activation.tensor(linear(x))
-        return self.output(x).squeeze(-1)
+        x = self.output(x)
+        return x.squeeze(-1) if self.outputs == 1 else x
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         value = self.raw(x)
@@ -48,14 +52,19 @@ class Network(torch.nn.Module):
 
     def formula(self, states: Sequence[str], digits: int) -> E.Expr:
         """The exact formula of the network with weights rounded to `digits` decimals."""
+        return self.formulas(states, digits)[0]
+
+    def formulas(self, states: Sequence[str], digits: int) -> list[E.Expr]:
+        """One exact formula per output."""
         values: list[E.Expr] = [E.Var(s) for s in states]
         for linear, activation in zip(self.linears, self.activations):
             pre = _affine(linear, values, digits)
             values = [activation.apply(z, i, len(pre)) for i, z in enumerate(pre)]
-        result = _affine(self.output, values, digits)[0]
+        results = _affine(self.output, values, digits)
         if self.subtract_origin:
-            result = E.add(result, E.neg(E.substitute(result, {s: E.ZERO for s in states})))
-        return result
+            origin = {s: E.ZERO for s in states}
+            results = [E.add(r, E.neg(E.substitute(r, origin))) for r in results]
+        return results
 
 
 def rational(value: float, digits: int) -> Fraction:

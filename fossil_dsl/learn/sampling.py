@@ -6,15 +6,18 @@ from typing import Sequence
 
 import torch
 
-from fossil_dsl.ir.sets import SetExpr
+from fossil_dsl.ir.sets import Boundary, SetExpr
 from fossil_dsl.learn.evaluate import holds, state_env
 
 MAX_ROUNDS = 50
+BISECTION_STEPS = 40
 
 
 def sample(region: SetExpr, states: Sequence[str], count: int, generator: torch.Generator,
            fallback_box=None) -> torch.Tensor:
     """Up to `count` points of `region` (fewer if the set is very thin in its box)."""
+    if isinstance(region, Boundary):
+        return _boundary(region.inner, states, count, generator, fallback_box)
     box = region.bounding_box() or fallback_box
     if box is None:
         raise ValueError(f"cannot sample {region}: no bounding box")
@@ -45,3 +48,41 @@ def around(points: torch.Tensor, region: SetExpr, states: Sequence[str], count: 
     keep = holds(region.contains_formula(states), state_env(states, neighbours),
                  len(neighbours))
     return torch.cat([points, neighbours[keep]])
+
+
+def _boundary(inner: SetExpr, states, count: int, generator, fallback_box) -> torch.Tensor:
+    """Points within ~1e-12 of the boundary of `inner`: bisect segments from a point of
+    the set to a point outside it (in its box grown by a fifth). Any set shape works; the
+    verifier, not these points, decides the condition on the exact boundary."""
+    box = inner.bounding_box() or fallback_box
+    if box is None:
+        raise ValueError(f"cannot sample the boundary of {inner}: no bounding box")
+    low = torch.tensor(box[0], dtype=torch.float64)
+    high = torch.tensor(box[1], dtype=torch.float64)
+    grow = 0.2 * (high - low) + 1e-3
+    formula = inner.contains_formula(states)
+    inside = sample(inner, states, count, generator, fallback_box)
+    if len(inside) == 0:
+        return inside
+    outside = sample_outside(formula, states, low - grow, high + grow, len(inside), generator)
+    if len(outside) == 0:
+        return outside
+    a, b = inside[:len(outside)], outside[:len(inside)]
+    for _ in range(BISECTION_STEPS):
+        middle = (a + b) / 2
+        in_set = holds(formula, state_env(states, middle), len(middle)).unsqueeze(1)
+        a, b = torch.where(in_set, middle, a), torch.where(in_set, b, middle)
+    return a
+
+
+def sample_outside(formula, states, low, high, count: int, generator) -> torch.Tensor:
+    found, total = [], 0
+    for _ in range(MAX_ROUNDS):
+        batch = low + (high - low) * torch.rand(max(count, 64) * 2, len(states),
+                                                generator=generator, dtype=torch.float64)
+        outside = batch[~holds(formula, state_env(states, batch), len(batch))]
+        found.append(outside)
+        total += len(outside)
+        if total >= count:
+            break
+    return torch.cat(found)[:count]

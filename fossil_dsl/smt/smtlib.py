@@ -26,15 +26,18 @@ def number(value: Fraction) -> str:
 
 
 class Printer:
-    def __init__(self, states: Sequence[str]):
+    def __init__(self, states: Sequence[str], constants: Sequence[str] = ()):
         self.states = tuple(states)
         self.arguments = " ".join(self.states)
+        self.constants = frozenset(constants)  # placeholders that are numbers, not functions
 
     def term(self, expr: E.Expr) -> str:
         if isinstance(expr, E.Num):
             return number(expr.value)
         if isinstance(expr, E.Var):
             if expr.name.startswith("$"):
+                if expr.name[1:] in self.constants:
+                    return expr.name[1:]
                 return f"({expr.name[1:]} {self.arguments})"
             return expr.name
         if isinstance(expr, E.Pi):
@@ -100,16 +103,21 @@ def _logic(formula: L.Formula, definitions) -> str:
 
 def query_text(formula: L.Formula, states: Sequence[str],
                functions: Mapping[str, E.Expr | None] = {}, comments: Sequence[str] = (),
-               logic: str | None = None) -> str:
+               logic: str | None = None, levels: Mapping[str, Fraction | None] = {}) -> str:
     """A complete SMT-LIB 2 script: unsat means the condition holds.
 
     `functions` maps a placeholder name ("V", "dV") to its definition, or to None to
-    declare it as an unknown function (a query before anything is learned)."""
-    printer = Printer(states)
-    logic = logic or _logic(formula, functions.values())
+    declare it as an unknown function (a query before anything is learned); `levels`
+    likewise maps a number placeholder ("beta") to its value or None."""
+    printer = Printer(states, levels)
+    logic = logic or _logic(formula, list(functions.values()) + [
+        None if value is None else E.Num(value) for value in levels.values()])
     lines = [f"; {c}" for c in comments]
     lines.append(f"(set-logic {logic})")
     lines += [f"(declare-const {s} Real)" for s in states]
+    for name, value in levels.items():
+        lines.append(f"(declare-const {name} Real)" if value is None else
+                     f"(define-fun {name} () Real {number(value)})")
     signature = " ".join(f"({s} Real)" for s in states)
     for name, definition in functions.items():
         if definition is None:

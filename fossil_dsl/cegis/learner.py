@@ -1,0 +1,271 @@
+"""The learning side of CEGIS: networks for the certificate's functions (and the
+controller), their training samples, the levels chosen from data, and the loss.
+
+Nothing here proves anything: the loop turns what is learned into exact formulas and
+hands those to the verifier.
+"""
+from __future__ import annotations
+
+import time
+
+import torch
+
+from fossil_dsl.certificates.base import Condition, Level, change_of, level_of, value_of
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.learn.evaluate import evaluate, holds, state_env
+from fossil_dsl.learn.networks import Network
+from fossil_dsl.learn.sampling import around, sample
+from fossil_dsl.plan import Plan
+
+GUARD_BAND = 0.1  # a guard such as B(x) = 0 is learned on a band this wide (relative)
+
+
+class Learner:
+    def __init__(self, plan: Plan, generator: torch.Generator):
+        self.plan = plan
+        self.states = plan.states
+        self.generator = generator
+        self.box = plan.spec.domain.bounding_box()
+        self.networks = {f.name: Network(len(self.states), f.layers, f.zero_at_origin)
+                         for f in plan.functions if f.candidate is None}
+        self.candidates = {f.name: f.candidate for f in plan.functions
+                           if f.candidate is not None}
+        self.controller = None
+        if plan.controller is not None:
+            c = plan.controller
+            self.controller = Network(len(self.states), c.layers, c.zero_at_origin,
+                                      outputs=len(c.inputs))
+        self.conditions = {c.name: c for c in plan.conditions}
+        needed = set().union(*(placeholders(c) for c in plan.conditions))
+        self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
+        self.samples = self.initial_samples()
+        self.control_samples = sample(plan.spec.domain, self.states, 500, generator, self.box) \
+            if self.controller is not None else None
+        self.parameters = [p for m in self.modules() for p in m.parameters()]
+        self.optimiser = torch.optim.Adam(self.parameters, lr=plan.options.learning_rate) \
+            if self.parameters else None
+
+    def modules(self) -> list[Network]:
+        return list(self.networks.values()) + ([self.controller] if self.controller else [])
+
+    @property
+    def trainable(self) -> bool:
+        return self.optimiser is not None
+
+    # ---- samples ----
+    def initial_samples(self) -> dict[str, torch.Tensor]:
+        """Conditions over the same set with the same count share their first samples."""
+        drawn: dict[tuple[str, int], torch.Tensor] = {}
+        result = {}
+        for condition in self.plan.conditions:
+            count = self.plan.samples[condition.name]
+            key = (condition.region.text(), count)
+            if key not in drawn:
+                drawn[key] = sample(condition.region, self.states, count, self.generator,
+                                    self.box)
+            result[condition.name] = drawn[key]
+        return result
+
+    def add_counterexample(self, name: str, point) -> None:
+        condition = self.conditions[name]
+        centre = torch.tensor([list(map(float, point))], dtype=torch.float64)
+        scale = _box_scale(self.box)
+        extra = around(centre, condition.region, self.states,
+                       self.plan.options.counterexample_neighbours, 0.02 * scale,
+                       self.generator)
+        if len(extra) == 1:  # a set of measure zero (a boundary): weigh the point itself
+            extra = extra.repeat(5, 1)
+        self.samples[name] = torch.cat([self.samples[name], extra])
+
+    def add_region_samples(self, name: str, count: int = 100) -> None:
+        """After UNKNOWN: learn more about the whole region the query was about."""
+        region = self.conditions[name].region
+        extra = sample(region, self.states, count, self.generator, self.box)
+        self.samples[name] = torch.cat([self.samples[name], extra])
+
+    # ---- values ----
+    def field(self, points: torch.Tensor) -> list[torch.Tensor]:
+        """The closed-loop vector field (or next state) at the points."""
+        env = state_env(self.states, points)
+        if self.controller is not None:
+            inputs = self.controller(points)
+            inputs = inputs.unsqueeze(1) if inputs.dim() == 1 else inputs
+            env.update({u: inputs[:, i] for i, u in enumerate(self.plan.controller.inputs)})
+        return [torch.as_tensor(evaluate(f, env), dtype=torch.float64).expand(len(points))
+                for f in self.plan.spec.dynamics]
+
+    def function(self, name: str, points: torch.Tensor) -> torch.Tensor:
+        if name in self.networks:
+            return self.networks[name](points)
+        value = evaluate(self.candidates[name], state_env(self.states, points))
+        return torch.as_tensor(value, dtype=torch.float64).expand(len(points))
+
+    def values(self, points: torch.Tensor, names) -> dict[str, torch.Tensor]:
+        """Each named function's value and change (derivative along the flow, or
+        one-step difference) at the points, which must require gradients."""
+        result, field = {}, None
+        for name in names:
+            value = self.function(name, points)
+            result[value_of(name).name] = value
+            if change_of(name).name not in self.changes_needed:
+                continue
+            field = field if field is not None else self.field(points)
+            if self.plan.spec.time is TimeDomain.DISCRETE:
+                change = self.function(name, torch.stack(field, 1)) - value
+            else:
+                grad, = torch.autograd.grad(value.sum(), points, create_graph=True)
+                change = sum(grad[:, i] * f for i, f in enumerate(field))
+            result[change_of(name).name] = change
+        return result
+
+    def environment(self, condition: Condition, points: torch.Tensor, levels) -> dict:
+        env = state_env(self.states, points)
+        needed = placeholders(condition)
+        names = [f for f in self._function_names
+                 if value_of(f).name in needed or change_of(f).name in needed]
+        env.update(self.values(points, names))
+        env.update({level_of(k).name: v for k, v in levels.items()})
+        return env
+
+    @property
+    def _function_names(self):
+        return [f.name for f in self.plan.functions]
+
+    # ---- levels ----
+    def levels(self) -> dict[str, float]:
+        return {level.name: self.level(level) for level in self.plan.levels}
+
+    def level(self, level: Level) -> float:
+        with torch.no_grad():
+            above = self.function(level.function, self.samples[level.above])
+            below = self.function(level.function, self.samples[level.below]) \
+                if level.below is not None else None
+        low = float(above.min()) if len(above) else None
+        if below is None:
+            return 0.0 if low is None else low - 2 * self.plan.options.margin
+        return _between(float(below.max()) if len(below) else None, low)
+
+    # ---- loss ----
+    def loss(self) -> tuple[torch.Tensor, bool]:
+        levels = self.levels()
+        total, satisfied = torch.zeros((), dtype=torch.float64), True
+        for condition in self.plan.conditions:
+            points = self.samples[condition.name]
+            if condition.exclude_origin:
+                points = points[points.norm(dim=1) > 1e-6]
+            if len(points) == 0:
+                continue
+            term, ok = self.condition_loss(condition, points, levels)
+            total = total + condition.weight * term
+            satisfied = satisfied and ok
+        if self.controller is not None:
+            total = total + self.plan.options.control_weight * self.control_loss()
+        return total, satisfied
+
+    def condition_loss(self, condition: Condition, points: torch.Tensor, levels):
+        points = points.clone().requires_grad_(True)
+        env = self.environment(condition, points, levels)
+        violation = violation_of(condition.claim, env)
+        margin = self.plan.options.margin
+        if condition.scaled_margin:
+            margin = margin * (points ** 2).sum(1)
+        mask = guard_mask(condition.guard, env, len(points), GUARD_BAND)
+        shortfall = torch.relu(violation + margin)
+        if condition.escapable_guard:
+            escape = torch.relu(margin - violation_of(condition.guard, env))
+            shortfall = torch.minimum(shortfall, escape)
+        shortfall = shortfall[mask]
+        if len(shortfall) == 0:
+            return torch.zeros((), dtype=torch.float64), True
+        return shortfall.mean(), bool((shortfall == 0).all())
+
+    def control_loss(self) -> torch.Tensor:
+        """Rewards a closed-loop field pointing towards the origin."""
+        points = self.control_samples
+        points = points[points.norm(dim=1) > 1e-6]
+        field = torch.stack(self.field(points), 1)
+        return torch.nn.functional.cosine_similarity(points, field, dim=1, eps=1e-9).mean()
+
+    def train(self, steps: int, deadline: float) -> float:
+        loss_value = 0.0
+        for _ in range(steps):
+            loss, satisfied = self.loss()
+            loss_value = float(loss.detach())
+            if satisfied or time.monotonic() > deadline:
+                break
+            self.optimiser.zero_grad()
+            loss.backward()
+            _clip_gradients(self.parameters, 10.0)
+            self.optimiser.step()
+        for network in self.modules():
+            network.round_weights(self.plan.options.digits)
+        return loss_value
+
+    # ---- learn-only ----
+    def violation_rates(self, generator: torch.Generator) -> dict[str, tuple[int, int]]:
+        """For each condition: how many fresh samples (not trained on) violate it, of how
+        many where its guard holds exactly."""
+        levels = self.levels()
+        rates = {}
+        for condition in self.plan.conditions:
+            points = sample(condition.region, self.states, self.plan.samples[condition.name],
+                            generator, self.box)
+            if condition.exclude_origin:
+                points = points[points.norm(dim=1) > 1e-9]
+            points = points.clone().requires_grad_(True)
+            env = self.environment(condition, points, levels)
+            env = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
+            considered = holds(condition.guard, env, len(points))
+            fails = ~holds(condition.claim, env, len(points)) & considered
+            rates[condition.name] = (int(fails.sum()), int(considered.sum()))
+        return rates
+
+
+def placeholders(condition: Condition) -> frozenset[str]:
+    return frozenset(n for n in L.free_vars(condition.claim) | L.free_vars(condition.guard)
+                     if n.startswith("$"))
+
+
+def violation_of(claim: L.Formula, env) -> torch.Tensor:
+    """How far the claim is from holding (positive: violated)."""
+    if not isinstance(claim, L.Compare):
+        raise TypeError(f"a claim must be one comparison, not {claim}")
+    difference = evaluate(claim.left, env) - evaluate(claim.right, env)
+    return difference if claim.relation in ("<", "<=") else -difference
+
+
+def guard_mask(guard: L.Formula, env, batch: int, band: float) -> torch.Tensor:
+    if guard == L.TRUE:
+        return torch.ones(batch, dtype=torch.bool)
+    scale = max((float(v.detach().abs().mean()) for k, v in env.items()
+                 if k.startswith("$") and isinstance(v, torch.Tensor) and v.dim() > 0),
+                default=1.0)
+    detached = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
+    return holds(guard, detached, batch, band * scale)
+
+
+def _between(high: float | None, low: float | None) -> float:
+    """A level above `high` and below `low` (halfway), or just beyond the one given."""
+    if high is not None and low is not None:
+        return (high + low) / 2
+    if low is not None:
+        return low - 0.01 * (abs(low) + 1e-3)
+    if high is not None:
+        return high + 0.01 * (abs(high) + 1e-3)
+    return 0.0
+
+
+def _clip_gradients(parameters, limit: float) -> None:
+    """Scale gradients down to norm `limit` (torch's clip_grad_norm_ costs ~1.6 ms a call)."""
+    norm = float(sum(p.grad.pow(2).sum() for p in parameters if p.grad is not None)) ** 0.5
+    if norm > limit:
+        for p in parameters:
+            if p.grad is not None:
+                p.grad.mul_(limit / norm)
+
+
+def _box_scale(box) -> float:
+    if box is None:
+        return 1.0
+    return max(high - low for low, high in zip(*box))
