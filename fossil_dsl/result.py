@@ -69,6 +69,10 @@ class Result:
                          "before verifying; the rounded function is the one proved")
         return found
 
+    def summary(self) -> str:
+        """The text `fossilc` prints: verdict, formulas, conditions, guarantee."""
+        return summary_text(self)
+
     def to_json(self) -> dict:
         plan = self.plan
         return {
@@ -164,9 +168,10 @@ def summary_text(result: Result) -> str:
     lines.append(f"  guarantee: {result.guarantee()}")
     if result.certified:
         lines += [f"  assumes: {a}" for a in result.assumptions()]
+    verifier = "no verifier (learn-only)" if result.learn_only else f"verifier {plan.verifier}"
     lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
                  f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"
-                 f"{'' if result.iterations == 1 else 's'}, verifier {plan.verifier}, "
+                 f"{'' if result.iterations == 1 else 's'}, {verifier}, "
                  f"seed {plan.options.seed}")
     return "\n".join(lines)
 

@@ -19,6 +19,7 @@ ALLOWED = {
     "learn": {"ir"},
     "cegis": {"ir", "certificates", "learn", "plan", "smt"},
     "result": {"version", "ir", "plan", "cegis", "smt"},
+    "extend": {"ir", "check", "certificates"},
     "api": {"diagnostics", "ir", "syntax", "check", "plan", "cegis", "result", "smt"},
     "cli": {"version", "diagnostics", "api", "plan", "result", "smt"},
 }

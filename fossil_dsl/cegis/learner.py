@@ -205,7 +205,8 @@ class Learner:
     # ---- learn-only ----
     def violation_rates(self, generator: torch.Generator) -> dict[str, tuple[int, int]]:
         """For each condition: how many fresh samples (not trained on) violate it, of how
-        many where its guard holds exactly."""
+        many where its guard holds (within the band used in training, since a guard
+        such as B(x) = 0 holds exactly on no sample)."""
         levels = self.levels()
         rates = {}
         for condition in self.plan.conditions:
@@ -215,8 +216,8 @@ class Learner:
                 points = points[points.norm(dim=1) > 1e-9]
             points = points.clone().requires_grad_(True)
             env = self.environment(condition, points, levels)
+            considered = guard_mask(condition.guard, env, len(points), GUARD_BAND)
             env = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
-            considered = holds(condition.guard, env, len(points))
             fails = ~holds(condition.claim, env, len(points)) & considered
             rates[condition.name] = (int(fails.sum()), int(considered.sum()))
         return rates

@@ -75,8 +75,9 @@ FORMS: list[PropertyForm] = [
 
 
 def register_form(form: PropertyForm) -> None:
-    """Add a property form (for user-defined certificates); later forms win ties."""
-    FORMS.insert(0, form)
+    """Add a property form (for user-defined certificates), replacing one of the same
+    name; later forms win ties."""
+    FORMS[:] = [form] + [f for f in FORMS if f.name != form.name]
 
 
 # ---- normal form: nested tuples ------------------------------------------------------
