@@ -71,62 +71,6 @@ def test_certificate_is_exact_and_reported(tmp_path):
     assert "V(x) = " in (tmp_path / "certificate.txt").read_text()
 
 
-# ---- soundness: false properties are never certified, whatever the seed -------------
-FALSE_PROPERTIES = {
-    "saddle-origin": """\
-state x0, x1
-dynamics continuous {
-    x0' = x0 + x1
-    x1' = -x1
-}
-domain ball([0, 0], 1)
-prove stable
-""",
-    "expanding-map": """\
-state x0, x1
-dynamics discrete {
-    next(x0) = 1.1*x0
-    next(x1) = 0.5*x1
-}
-domain box([-1, -1], [1, 1])
-prove stable
-""",
-    "flow-into-unsafe": """\
-state x0, x1
-dynamics continuous {
-    x0' = 1
-    x1' = -x1
-}
-domain box([-2, -2], [2, 2])
-set init = box([-0.5, -0.5], [0, 0.5])
-set unsafe = box([1, -2], [2, 2])
-prove from init: always not unsafe
-""",
-    "map-into-unsafe": """\
-state x0, x1
-dynamics discrete {
-    next(x0) = x0 + 0.5
-    next(x1) = 0.5*x1
-}
-domain box([-2, -2], [2, 2])
-set init = box([-0.5, -0.5], [0, 0.5])
-set unsafe = box([1, -2], [2, 2])
-prove from init: always not unsafe
-""",
-}
-
-
-@pytest.mark.parametrize("seed", [0, 1, 2])
-@pytest.mark.parametrize("name", FALSE_PROPERTIES)
-def test_false_property_is_never_certified(name, seed):
-    result = fossil_dsl.synthesise(spec_text(FALSE_PROPERTIES[name]), seed=seed, max_iters=2,
-                                   learn_steps=300, query_timeout=5)
-    assert not result.certified
-    assert result.exit_code == 1
-    assert result.guarantee() == "nothing is proved"
-    assert any(c.status != "unsat" for c in result.conditions)
-
-
 # ---- the verifier alone: a wrong certificate is rejected with a counterexample ------
 LINEAR = """\
 state x0, x1
@@ -177,8 +121,11 @@ def test_loop_only_certifies_on_unsat(status):
     assert result.verdict == "not certified"
 
 
+SADDLE = LINEAR.replace("x0' = -x0", "x0' = x0 + x1")
+
+
 def test_timeout_ends_the_run_not_certified():
-    result = fossil_dsl.synthesise(spec_text(FALSE_PROPERTIES["saddle-origin"]), timeout=1,
+    result = fossil_dsl.synthesise(spec_text(SADDLE), timeout=1,
                                    max_iters=100)
     assert not result.certified and "timeout" in result.reason
 

@@ -81,6 +81,46 @@ def test_controller_keeps_the_equilibrium_where_stability_needs_it():
 
 # ---- false properties of every kind: never certified, whatever the seed ------------------
 FALSE_PROPERTIES = {
+    "saddle-origin": """\
+state x0, x1
+dynamics continuous {
+    x0' = x0 + x1
+    x1' = -x1
+}
+domain ball([0, 0], 1)
+prove stable
+""",
+    "expanding-map": """\
+state x0, x1
+dynamics discrete {
+    next(x0) = 1.1*x0
+    next(x1) = 0.5*x1
+}
+domain box([-1, -1], [1, 1])
+prove stable
+""",
+    "flow-into-unsafe": """\
+state x0, x1
+dynamics continuous {
+    x0' = 1
+    x1' = -x1
+}
+domain box([-2, -2], [2, 2])
+set init = box([-0.5, -0.5], [0, 0.5])
+set unsafe = box([1, -2], [2, 2])
+prove from init: always not unsafe
+""",
+    "map-into-unsafe": """\
+state x0, x1
+dynamics discrete {
+    next(x0) = x0 + 0.5
+    next(x1) = 0.5*x1
+}
+domain box([-2, -2], [2, 2])
+set init = box([-0.5, -0.5], [0, 0.5])
+set unsafe = box([1, -2], [2, 2])
+prove from init: always not unsafe
+""",
     # trajectories converge to the origin; the goal is elsewhere
     "goal-never-reached": """\
 state x0, x1
@@ -116,17 +156,6 @@ dynamics continuous {
 domain box([-1.5, -1.5], [1.5, 1.5])
 set init = ball([0, 0], 1.1)
 prove from init: stable
-""",
-    "init-outside-roa-swa": """\
-state x0, x1
-dynamics continuous {
-    x0' = -x0 + x0^3
-    x1' = -x1
-}
-domain box([-1.5, -1.5], [1.5, 1.5])
-set init = ball([0, 0], 1.1)
-set unsafe = box([1.3, 1.3], [1.5, 1.5])
-prove from init: stable and always not unsafe
 """,
     # trajectories pass through `final` on their way to the origin, outside it
     "final-set-left": """\
@@ -168,6 +197,11 @@ set init = ball([0, 0], 0.5)
 prove from init: stable
 """,
 }
+
+
+FALSE_PROPERTIES["init-outside-roa-swa"] = FALSE_PROPERTIES["init-outside-roa"].replace(
+    "prove from init: stable", "set unsafe = box([1.3, 1.3], [1.5, 1.5])\n"
+    "prove from init: stable and always not unsafe")
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
