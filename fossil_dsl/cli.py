@@ -42,10 +42,23 @@ def _report(result: CheckResult, out: Console, err: Console, quiet: bool,
 
 def command_check(args: argparse.Namespace) -> int:
     out, err = _consoles()
-    results = [check_file(path) for path in args.specs]
-    for result in results:
+    good = True
+    for path in args.specs:
+        result = check_file(path)
         _report(result, out, err, args.quiet)
-    return EXIT_OK if all(r.ok for r in results) else EXIT_BAD_SPEC
+        good = good and result.ok and _report_verifier(result, out, err)
+    return EXIT_OK if good else EXIT_BAD_SPEC
+
+
+def _report_verifier(result: CheckResult, out: Console, err: Console) -> bool:
+    """Which verifier a run would use, and why (False if the spec cannot be compiled)."""
+    try:
+        plan = compile_spec(result.spec)
+    except (CompileError, BackendUnavailable) as exc:
+        _compile_error(exc, result, err)
+        return False
+    out.print(f"  verifier: {plan.verifier} ({plan.verifier_reason})", markup=False)
+    return True
 
 
 def command_run(args: argparse.Namespace) -> int:

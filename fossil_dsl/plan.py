@@ -3,6 +3,7 @@ the set each ranges over), what to sample, and which verifier decides the querie
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from fractions import Fraction
 from types import MappingProxyType
 from typing import Mapping
 
@@ -30,6 +31,9 @@ class CompileError(FslError):
 
     def diagnostic(self) -> Diagnostic:
         return error(str(self), self.span)
+
+
+ORIGIN_RADIUS = Fraction(1, 100)  # the reference tool's annulus (its "torus" domains)
 
 
 @dataclass(frozen=True)
@@ -68,10 +72,22 @@ class Plan:
     verifier_reason: str
     samples: Mapping[str, int]  # condition name -> number of training samples
     options: RunOptions
+    # conditions that exclude the origin exclude the ball of this radius (a delta-decision
+    # verifier cannot refute a closed set that touches the origin, where V = dV = 0)
+    origin_radius: Fraction = Fraction(0)
 
     @property
     def states(self) -> tuple[str, ...]:
         return self.spec.states
+
+    def query(self, condition: Condition) -> L.Formula:
+        """The condition's query (satisfiable exactly when it fails), before the learned
+        functions are substituted."""
+        return condition.query(self.states, self.origin_radius)
+
+    @property
+    def excludes_a_ball(self) -> bool:
+        return self.origin_radius > 0 and any(c.exclude_origin for c in self.conditions)
 
 
 def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None,
@@ -89,8 +105,9 @@ def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None
                                        overrides.pop("verifier", None))
     options = _options(spec, overrides)
     samples = {c.name: _sample_count(spec, c.region) for c in conditions}
+    radius = ORIGIN_RADIUS if registry.BACKENDS[verifier].delta_decision else Fraction(0)
     return Plan(spec, rule, functions, conditions, tuple(rule.levels()), controller,
-                verifier, reason, MappingProxyType(samples), options)
+                verifier, reason, MappingProxyType(samples), options, radius)
 
 
 def _certificate(spec: CheckedSpec, given: type[Certificate] | None) -> Certificate:
@@ -180,9 +197,15 @@ def choose_verifier(spec: CheckedSpec, functions, controller,
         return requested, "named in the spec or on the command line"
     if is_polynomial_problem(spec, functions, controller):
         return "z3", "the problem is polynomial arithmetic, which Z3 decides completely"
+    missing = []
     for info in sorted(registry.BACKENDS.values(), key=lambda b: b.rank):
-        if info.transcendental and registry.is_installed(info.name):
-            return info.name, f"the problem has transcendental functions; {info.summary}"
+        if not info.transcendental:
+            continue
+        if registry.is_installed(info.name):
+            unavailable = f" ({', '.join(missing)} not installed)" if missing else ""
+            return info.name, (f"the problem has transcendental functions; {info.summary}"
+                               f"{unavailable}")
+        missing.append(info.name)
     raise CompileError("no installed verifier handles transcendental functions")
 
 
@@ -215,6 +238,9 @@ def plan_text(plan: Plan, explain: bool = False) -> str:
         left = f"{state}{mark}" if mark else f"next({state})"
         lines.append(f"  {left} = {f}")
     lines.append(f"verifier: {plan.verifier} ({plan.verifier_reason})")
+    if plan.excludes_a_ball:
+        lines.append(f"  it is a delta-decision procedure: conditions for x ≠ 0 are proved for "
+                     f"|x| > {plan.origin_radius} (ε-stability for ε = {plan.origin_radius})")
     options = plan.options
     lines.append(f"loop: at most {options.max_iters} iterations, {options.timeout:g} s, "
                  f"seed {options.seed}")
@@ -273,7 +299,7 @@ def symbolic_queries(plan: Plan) -> dict[str, str]:
                     "unsat means the condition holds; d" + plan.functions[0].name +
                     (" is the one-step difference" if plan.certificate.discrete
                      else " is the derivative along the flow")]
-        result[condition.name] = query_text(condition.query(plan.states), plan.states,
+        result[condition.name] = query_text(plan.query(condition), plan.states,
                                             functions, comments,
                                             levels={level.name: None for level in plan.levels})
     return result

@@ -11,6 +11,7 @@ from fossil_dsl.version import __version__
 from fossil_dsl.cegis.loop import CegisOutcome
 from fossil_dsl.ir import expr as E
 from fossil_dsl.plan import Plan
+from fossil_dsl.smt import registry
 from fossil_dsl.smt.smtlib import query_text
 
 SCHEMA_VERSION = 1
@@ -56,6 +57,12 @@ class Result:
         if not self.certified:
             return "nothing is proved"
         text = self.plan.certificate.guarantee()
+        if self.plan.excludes_a_ball:
+            r = self.plan.origin_radius
+            text = (f"ε-stability for ε = {r}: the conditions that exclude the origin were "
+                    f"proved outside the ball |x| <= {r} only, so trajectories reach, and stay "
+                    "in, the smallest sublevel set of V that contains that ball, rather than "
+                    f"converging to the origin itself. Apart from that ball: {text}")
         return text + (" (for the closed loop with the controller shown)"
                        if self.controller else "")
 
@@ -64,6 +71,13 @@ class Result:
         found = [f"every condition was proved by {plan.verifier} (its queries were UNSAT) "
                  "for the exact formulas shown",
                  "the conditions are checked only inside the domain D"]
+        info = registry.BACKENDS[plan.verifier]
+        if info.caveat:
+            found.append(info.caveat)
+        if info.delta_decision:
+            found.append(f"{plan.verifier} is a delta-decision procedure: only its UNSAT "
+                         "answers are used as proofs, and it proves the closed (stronger) "
+                         "form of strict inequalities")
         if any(f.candidate is None for f in plan.functions):
             found.append(f"network weights were rounded to {plan.options.digits} decimals "
                          "before verifying; the rounded function is the one proved")
@@ -136,7 +150,7 @@ def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
         comments = [f"{plan.spec.name}: condition {condition.name}: {condition.text}",
                     "unsat means the condition holds",
                     f"each dC below is the {change}, computed exactly from C", *loop]
-        scripts[condition.name] = query_text(condition.query(plan.states), plan.states,
+        scripts[condition.name] = query_text(plan.query(condition), plan.states,
                                              functions, comments, levels=candidate.levels)
     return scripts
 

@@ -1,4 +1,5 @@
 """The `fossilc` command as a user meets it: a real process, its output and exit code."""
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -51,8 +52,16 @@ def test_check_bundled_specs_ok():
 def test_check_summary_line_for_the_case_study():
     run = fossilc("check", ROOT / "specs" / "pendulum_rar.fsl")
     assert run.returncode == 0
-    assert run.stdout.strip().endswith(
+    first, second = run.stdout.strip().splitlines()
+    assert first.endswith(
         "reach-avoid-remain (RWA + barrier), 2 states, 2 inputs, continuous time")
+    # sin in the model: no polynomial verifier; dReal where installed, else intervals
+    assert re.match(r"  verifier: (dreal|interval) \(the problem has transcendental", second)
+
+
+def test_check_names_z3_for_polynomial_specs():
+    run = fossilc("check", ROOT / "specs" / "stability_continuous.fsl")
+    assert "  verifier: z3 (the problem is polynomial arithmetic" in run.stdout
 
 
 def test_check_reports_error_with_location_and_exit_2(tmp_path):

@@ -201,7 +201,7 @@ class Cegis:
         mapping = candidate.mapping()
         verdicts, queries = [], {}
         for condition in self.plan.conditions:
-            query = L.substitute(condition.query(self.states), mapping)
+            query = L.substitute(self.plan.query(condition), mapping)
             queries[condition.name] = query
             budget = max(1.0, min(self.options.query_timeout, self.deadline - time.monotonic()))
             answer = self.backend.check(query, self.states, budget)

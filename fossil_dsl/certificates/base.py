@@ -9,6 +9,7 @@ certificate rule gets its losses from its conditions.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import ClassVar
 
 from fossil_dsl.diagnostics import FslError
@@ -71,12 +72,14 @@ class Condition:
     # e.g. by lowering V below a level where V cannot decrease
     escapable_guard: bool = False
 
-    def query(self, states) -> L.Formula:
-        """Satisfiable exactly when the condition fails (before substitution)."""
+    def query(self, states, origin_radius: Fraction = Fraction(0)) -> L.Formula:
+        """Satisfiable exactly when the condition fails (before substitution); with
+        `exclude_origin`, the points within `origin_radius` of the origin (or the origin
+        alone) are left out."""
         parts = [self.region.contains_formula(states), self.guard, L.negation(self.claim)]
         if self.exclude_origin:
             norm = E.add(*(E.power(E.Var(s), E.Num(2)) for s in states))
-            parts.insert(1, L.Compare(">", norm, E.ZERO))
+            parts.insert(1, L.Compare(">", norm, E.Num(origin_radius ** 2)))
         return L.conjunction(*parts)
 
 

@@ -83,6 +83,18 @@ _LOOSE = {"<": "<=", ">": ">=", "<=": "<=", ">=": ">="}
 _FLIPPED = {"<=": ">", "<": ">=", ">=": "<", ">": "<="}
 
 
+def negated_inward(formula: Formula) -> Formula:
+    """not(formula), with the negation moved down onto the comparisons (flipped)."""
+    if isinstance(formula, Compare):
+        return Compare(_FLIPPED[formula.relation], formula.left, formula.right)
+    if isinstance(formula, Not):
+        return formula.arg
+    if isinstance(formula, BoolConst):
+        return BoolConst(not formula.value)
+    parts = [negated_inward(arg) for arg in formula.args]
+    return disjunction(*parts) if isinstance(formula, And) else conjunction(*parts)
+
+
 def open_inner(formula: Formula) -> Formula:
     """An open set inside the set that `formula` describes (all comparisons strict).
 

@@ -19,6 +19,8 @@ class BackendInfo:
     transcendental: bool  # can decide sin, exp, ... (possibly delta-complete)
     summary: str
     rank: int  # preference among backends for transcendental problems (lower first)
+    delta_decision: bool = False  # UNSAT is sound, SAT means delta-SAT (closed relaxation)
+    caveat: str = ""  # what a proof by this backend assumes beyond UNSAT
 
 
 BACKENDS: dict[str, BackendInfo] = {b.name: b for b in (
@@ -27,9 +29,11 @@ BACKENDS: dict[str, BackendInfo] = {b.name: b for b in (
     BackendInfo("cvc5", "fossil_dsl.smt.cvc5_backend", "Cvc5Backend", "cvc5", True,
                 "CVC5, polynomial arithmetic and some transcendental queries", 3),
     BackendInfo("dreal", "fossil_dsl.smt.dreal_backend", "DrealBackend", "dreal", True,
-                "dReal, delta-complete for transcendental functions (optional)", 1),
+                "dReal, delta-complete for transcendental functions (optional)", 1, True,
+                "dReal's API reads each exact constant as the nearest double"),
     BackendInfo("interval", "fossil_dsl.smt.interval_backend", "IntervalBackend", "codac",
-                True, "a delta-decision procedure on outward-rounded interval arithmetic", 2),
+                True, "a delta-decision procedure on outward-rounded interval arithmetic", 2,
+                True),
 )}
 
 

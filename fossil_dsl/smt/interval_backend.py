@@ -1,0 +1,202 @@
+"""A delta-decision procedure on codac's outward-rounded interval arithmetic.
+
+The query is read as a closed set (strict comparisons are relaxed to non-strict ones,
+which only enlarges it), each comparison becomes codac's forward-backward contractor
+(with its centred form), `and`/`or` become intersection/union of contractors, and the
+boxes of a depth-first search are contracted and bisected:
+
+- UNSAT only when every box has been contracted to the empty set. Each contraction is an
+  interval computation under outward rounding, so the enlarged set, and therefore the
+  query, has no point in the box: the answer rests on no floating-point sampling.
+- delta-SAT when a box narrower than `delta` in every direction survives contraction;
+  its midpoint is returned as the counterexample (the query may be false there by at
+  most the interval overestimation: it is a lead for the learner, not a proof).
+- UNKNOWN on timeout, or when contraction cannot bound every variable.
+"""
+from __future__ import annotations
+
+import time
+from fractions import Fraction
+from typing import Sequence
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.enclosure import rational_interval, upward_rounding
+from fossil_dsl.smt.api import Answer, Status, UnsupportedTheory
+
+DELTA = 1e-3  # the width under which a surviving box counts as a (delta-)solution
+
+
+class IntervalBackend:
+    name = "interval"
+
+    def __init__(self, delta: float = DELTA):
+        self.delta = delta
+
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+        names = sorted(set(variables) | L.free_vars(formula))
+        deadline = time.monotonic() + timeout
+        with upward_rounding() as codac:
+            contractor = _Compiler(codac, names).formula(formula)
+            if contractor is None:  # the formula is TRUE: any point
+                return _unbounded() if names else Answer(Status.SAT, {})
+            start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
+            split = _worth_splitting(formula, names)
+            return self._search(contractor, start, names, split, variables, deadline)
+
+    def _search(self, contractor, start, names, split, variables, deadline) -> Answer:
+        contractor.contract(start)
+        if start.is_empty():
+            return Answer(Status.UNSAT)
+        if start.is_unbounded():
+            return _unbounded()
+        stack, boxes = [start], 0
+        while stack:
+            box = stack.pop()
+            boxes += 1
+            contractor.contract(box)
+            if box.is_empty():
+                continue
+            if max(box[i].diam() for i in split) < self.delta:
+                if _contract_to_fixpoint(contractor, box):
+                    continue
+                return _delta_sat(box, names, variables, self.delta)
+            if boxes % 256 == 0 and time.monotonic() > deadline:
+                return Answer(Status.UNKNOWN, reason=f"timeout after {boxes} boxes, "
+                              f"{len(stack) + 1} left to refute")
+            widest = max(split, key=lambda i: box[i].diam())
+            first, second = box.bisect(widest, 0.5)
+            stack += [second, first]
+        return Answer(Status.UNSAT)
+
+
+def _worth_splitting(formula: L.Formula, names) -> list[int]:
+    """The variables to bisect: those in a comparison other than a bound `x <= c`, which
+    contraction already enforces exactly (bisecting them would only multiply boxes)."""
+    involved = set()
+    for comparison in L.comparisons(formula):
+        sides = (comparison.left, comparison.right)
+        bound = any(isinstance(a, E.Var) for a in sides) and \
+            not any(E.free_vars(side) for side in sides if not isinstance(side, E.Var))
+        if not bound:
+            involved |= E.free_vars(comparison.left) | E.free_vars(comparison.right)
+    indices = [i for i, name in enumerate(names) if name in involved]
+    return indices or list(range(len(names)))
+
+
+def _contract_to_fixpoint(contractor, box, passes: int = 50) -> bool:
+    """Contract until the box stops shrinking (one forward-backward pass is not
+    idempotent); True if it becomes empty."""
+    for _ in range(passes):
+        before = box.max_diam()
+        contractor.contract(box)
+        if box.is_empty():
+            return True
+        if box.max_diam() > 0.99 * before:
+            return False
+    return False
+
+
+def _unbounded() -> Answer:
+    return Answer(Status.UNKNOWN, reason="the query does not bound every variable, and the "
+                  "interval verifier searches bounded boxes only")
+
+
+def _delta_sat(box, names, variables, delta) -> Answer:
+    middle = box.mid()
+    point = {name: Fraction(float(middle[i])) for i, name in enumerate(names)}
+    return Answer(Status.SAT, {v: point[v] for v in variables if v in point},
+                  reason=f"delta-sat (delta = {delta:g}): a box this narrow could not be refuted",
+                  approximate=True)
+
+
+class _Compiler:
+    """Neutral formulas and expressions to codac contractors and analytic expressions."""
+
+    def __init__(self, codac, names):
+        self.codac = codac
+        self.vector = codac.VectorVar(len(names))
+        self.index = {name: i for i, name in enumerate(names)}
+
+    def formula(self, formula: L.Formula):
+        """A contractor for the closure of the formula's set; None for TRUE."""
+        codac = self.codac
+        if isinstance(formula, L.BoolConst):
+            return None if formula.value else codac.CtcEmpty(len(self.index))
+        if isinstance(formula, L.Not):
+            return self.formula(L.negated_inward(formula.arg))
+        if isinstance(formula, L.Compare):
+            return self.compare(formula)
+        parts = [self.formula(arg) for arg in formula.args]
+        if isinstance(formula, L.And):
+            kept = [p for p in parts if p is not None]
+            return _combine(kept, lambda a, b: a & b) if kept else None
+        if any(p is None for p in parts):
+            return None
+        return _combine(parts, lambda a, b: a | b)
+
+    def compare(self, comparison: L.Compare):
+        codac = self.codac
+        difference = E.add(comparison.left, E.neg(comparison.right))
+        if not E.free_vars(difference):
+            return self.closed_comparison(comparison.relation, difference)
+        difference = self.expr(difference)
+        function = codac.AnalyticFunction([self.vector], difference)
+        below = comparison.relation in ("<", "<=")
+        allowed = codac.Interval(-codac.oo, 0) if below else codac.Interval(0, codac.oo)
+        return codac.CtcInverse_Interval(function, allowed)
+
+    def closed_comparison(self, relation: str, difference: E.Expr):
+        """A comparison without variables: empty only when certainly false."""
+        value = self.expr(difference)
+        below = relation in ("<", "<=")
+        false = value.lb() > 0 if below else value.ub() < 0
+        return self.codac.CtcEmpty(len(self.index)) if false else None
+
+    def expr(self, expr: E.Expr):
+        codac = self.codac
+        if isinstance(expr, E.Num):
+            return rational_interval(expr.value)
+        if isinstance(expr, E.Pi):
+            return codac.Interval.pi()
+        if isinstance(expr, E.Var):
+            if expr.name not in self.index:
+                raise UnsupportedTheory(f"unknown variable {expr.name}")
+            return self.vector[self.index[expr.name]]
+        if isinstance(expr, E.Neg):
+            return -self.expr(expr.operand)
+        if isinstance(expr, E.Add):
+            return _combine([self.expr(t) for t in expr.terms], lambda a, b: a + b)
+        if isinstance(expr, E.Mul):
+            return _combine([self.expr(f) for f in expr.factors], lambda a, b: a * b)
+        if isinstance(expr, E.Div):
+            return self.expr(expr.numerator) / self.expr(expr.denominator)
+        if isinstance(expr, E.Pow):
+            return self.power(expr)
+        if isinstance(expr, E.Apply):
+            if not hasattr(codac, expr.func):
+                raise UnsupportedTheory(f"the interval verifier has no `{expr.func}`")
+            return getattr(codac, expr.func)(self.expr(expr.arg))
+        raise UnsupportedTheory(f"cannot translate {expr!r}")
+
+    def power(self, expr: E.Pow):
+        codac = self.codac
+        base = self.expr(expr.base)
+        exponent = expr.exponent
+        if isinstance(exponent, E.Num) and exponent.value.denominator == 1:
+            n = int(exponent.value)
+            if n == 2:
+                return codac.sqr(base)
+            if n >= 0:
+                return codac.pow(base, n)
+            return 1 / codac.pow(base, -n)
+        if isinstance(exponent, E.Num) and exponent.value == Fraction(1, 2):
+            return codac.sqrt(base)
+        return codac.exp(self.expr(exponent) * codac.log(base))
+
+
+def _combine(items, join):
+    result = items[0]
+    for item in items[1:]:
+        result = join(result, item)
+    return result
