@@ -192,8 +192,9 @@ def choose_verifier(spec: CheckedSpec, functions, controller,
                                + ", ".join(registry.names()), span)
         if not registry.is_installed(requested):
             available = [n for n in registry.names() if registry.is_installed(n)]
-            raise CompileError(f"verifier `{requested}` is not available here; available: "
-                               + ", ".join(available), span)
+            raise CompileError(f"verifier `{requested}` is not available here (it needs the "
+                               f"Python package `{registry.BACKENDS[requested].requires}`); "
+                               "available: " + ", ".join(available), span)
         return requested, "named in the spec or on the command line"
     if is_polynomial_problem(spec, functions, controller):
         return "z3", "the problem is polynomial arithmetic, which Z3 decides completely"

@@ -40,6 +40,7 @@ class Result:
     learn_seconds: float
     verify_seconds: float
     total_seconds: float
+    digits: int = 3  # decimals the network weights were rounded to
 
     @property
     def verdict(self) -> str:
@@ -79,7 +80,7 @@ class Result:
                          "answers are used as proofs, and it proves the closed (stronger) "
                          "form of strict inequalities")
         if any(f.candidate is None for f in plan.functions):
-            found.append(f"network weights were rounded to {plan.options.digits} decimals "
+            found.append(f"network weights were rounded to {self.digits} decimals "
                          "before verifying; the rounded function is the one proved")
         return found
 
@@ -132,7 +133,7 @@ def build_result(plan: Plan, outcome: CegisOutcome, total_seconds: float) -> Res
     return Result(plan, outcome.certified, outcome.reason, dict(candidate.formulas),
                   dict(candidate.controller), dict(candidate.levels), reports,
                   obligations(plan, outcome), len(outcome.history), outcome.learn_seconds,
-                  outcome.verify_seconds, total_seconds)
+                  outcome.verify_seconds, total_seconds, candidate.digits)
 
 
 def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:

@@ -218,7 +218,8 @@ def test_false_property_is_never_certified(name, seed):
 @pytest.mark.parametrize("seed", [3, 4])
 @pytest.mark.parametrize("name", FALSE_PROPERTIES)
 def test_false_property_survives_a_full_run(name, seed):
-    result = fossil_dsl.synthesise(spec_text(FALSE_PROPERTIES[name]), seed=seed)
+    result = fossil_dsl.synthesise(spec_text(FALSE_PROPERTIES[name]), seed=seed,
+                                   query_timeout=10, timeout=300)
     assert not result.certified
 
 

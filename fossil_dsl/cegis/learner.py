@@ -6,6 +6,7 @@ hands those to the verifier.
 """
 from __future__ import annotations
 
+import copy
 import time
 
 import torch
@@ -19,6 +20,7 @@ from fossil_dsl.learn.sampling import around, sample
 from fossil_dsl.plan import Plan
 
 GUARD_BAND = 0.1  # a guard such as B(x) = 0 is learned on a band this wide (relative)
+EXTRA_DIGITS = 3  # decimals that rounding may add to the plan's when 3 undo the learning
 
 
 class Learner:
@@ -37,6 +39,7 @@ class Learner:
             self.controller = Network(len(self.states), c.layers, c.zero_at_origin,
                                       outputs=len(c.inputs))
         self.conditions = {c.name: c for c in plan.conditions}
+        self.digits = plan.options.digits  # of the last rounding
         needed = set().union(*(placeholders(c) for c in plan.conditions))
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
         self.samples = self.initial_samples()
@@ -198,9 +201,24 @@ class Learner:
             loss.backward()
             _clip_gradients(self.parameters, 10.0)
             self.optimiser.step()
-        for network in self.modules():
-            network.round_weights(self.plan.options.digits)
+        self.round_networks(satisfied_before=self.loss()[1])
         return loss_value
+
+    def round_networks(self, satisfied_before: bool) -> None:
+        """Round the weights to the fewest decimals (from the plan's `digits`, up to
+        EXTRA_DIGITS more) that keep every condition met on the samples, if training met
+        them: near the origin, rounding to 3 decimals can undo what was learned, and
+        the loop would then verify the same failing candidate again and again."""
+        saved = [copy.deepcopy(module.state_dict()) for module in self.modules()]
+        base = self.plan.options.digits
+        for self.digits in range(base, base + EXTRA_DIGITS + 1):
+            for module in self.modules():
+                module.round_weights(self.digits)
+            if not satisfied_before or self.loss()[1]:
+                return
+            if self.digits < base + EXTRA_DIGITS:
+                for module, state in zip(self.modules(), saved):
+                    module.load_state_dict(state)
 
     # ---- learn-only ----
     def violation_rates(self, generator: torch.Generator) -> dict[str, tuple[int, int]]:

@@ -65,6 +65,7 @@ class ExactCandidate:
     controller: dict[str, E.Expr]  # input name -> k_i(x)
     closed_loop: tuple[E.Expr, ...]
     levels: dict[str, Fraction]
+    digits: int  # decimals kept when the weights were rounded
 
     def mapping(self) -> dict[str, E.Expr]:
         found = {value_of(n).name: f for n, f in self.formulas.items()}
@@ -177,7 +178,7 @@ class Cegis:
 
     # ---- verification ----
     def exact_candidate(self) -> ExactCandidate:
-        digits = self.options.digits
+        digits = self.learner.digits
         learner = self.learner
         formulas = {f.name: f.candidate if f.candidate is not None
                     else learner.networks[f.name].formula(self.states, digits)
@@ -189,7 +190,7 @@ class Cegis:
         closed_loop = tuple(E.substitute(f, controller) for f in self.plan.spec.dynamics)
         changes = {name: self.change(formula, closed_loop) for name, formula in formulas.items()}
         levels = {name: _rational(value, digits) for name, value in learner.levels().items()}
-        return ExactCandidate(formulas, changes, controller, closed_loop, levels)
+        return ExactCandidate(formulas, changes, controller, closed_loop, levels, digits)
 
     def change(self, formula: E.Expr, dynamics) -> E.Expr:
         if self.plan.spec.time is TimeDomain.DISCRETE:

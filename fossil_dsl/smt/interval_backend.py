@@ -16,6 +16,7 @@ boxes of a depth-first search are contracted and bisected:
 from __future__ import annotations
 
 import time
+from collections import Counter
 from fractions import Fraction
 from typing import Sequence
 
@@ -24,7 +25,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import rational_interval, upward_rounding
 from fossil_dsl.smt.api import Answer, Status, UnsupportedTheory
 
-DELTA = 1e-3  # the width under which a surviving box counts as a (delta-)solution
+DELTA = 1e-4  # the width under which a surviving box counts as a (delta-)solution
 
 
 class IntervalBackend:
@@ -168,7 +169,11 @@ class _Compiler:
         if isinstance(expr, E.Add):
             return _combine([self.expr(t) for t in expr.terms], lambda a, b: a + b)
         if isinstance(expr, E.Mul):
-            return _combine([self.expr(f) for f in expr.factors], lambda a, b: a * b)
+            # x*x as sqr(x): interval multiplication does not know both factors are one
+            counts = Counter(expr.factors)
+            factors = [self.expr(f) if n == 1 else self.power(E.Pow(f, E.Num(n)))
+                       for f, n in counts.items()]
+            return _combine(factors, lambda a, b: a * b)
         if isinstance(expr, E.Div):
             return self.expr(expr.numerator) / self.expr(expr.denominator)
         if isinstance(expr, E.Pow):

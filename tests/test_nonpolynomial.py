@@ -1,0 +1,155 @@
+"""Non-polynomial models and certificates: the interval verifier (a delta-decision
+procedure on codac), CVC5 on transcendental queries, dReal where it is installed."""
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import fossil_dsl
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.enclosure import enclose
+from fossil_dsl.smt import registry
+from fossil_dsl.smt.api import Status
+from fossil_dsl.smt.cvc5_backend import Cvc5Backend
+from fossil_dsl.smt.interval_backend import IntervalBackend
+from fossil_dsl.smt.smtlib import query_text
+from fossil_dsl.smt.smtlib_reader import read_script
+
+ROOT = Path(__file__).resolve().parent.parent
+FOSSILC = Path(sys.executable).with_name("fossilc")
+
+PENDULUM = """\
+state x0, x1
+dynamics continuous {
+    x0' = x1
+    x1' = -sin(x0) - x1
+}
+domain ball([0, 0], 1)
+prove stable
+"""
+UPRIGHT = PENDULUM.replace("-sin(x0) - x1", "sin(x0) - x1")
+POLYNOMIAL = """\
+state x0, x1
+dynamics continuous {
+    x0' = -x0 + x0*x1
+    x1' = -x1
+}
+domain ball([0, 0], 1)
+prove stable
+"""
+
+
+def spec_text(text: str):
+    return fossil_dsl.loads(text, "test.fsl")
+
+
+def recheck_from_text(result) -> None:
+    """Every exported obligation, read back from its SMT-LIB text, is UNSAT for a fresh
+    interval verifier, and CVC5 never finds it satisfiable."""
+    for name, script in result.obligations.items():
+        read = read_script(script)
+        answer = IntervalBackend().check(read.formula, read.variables, timeout=120)
+        assert answer.status is Status.UNSAT, (name, answer)
+        assert Cvc5Backend().check_text(script, timeout=2).status is not Status.SAT, name
+
+
+def test_damped_pendulum_certified_with_epsilon_stability():
+    result = fossil_dsl.synthesise(spec_text(PENDULUM), seed=0)
+    assert result.certified, result.reason
+    assert result.plan.verifier in ("interval", "dreal")
+    assert "ε-stability for ε = 1/100" in result.guarantee()
+    assert any("delta-decision" in a for a in result.assumptions())
+    recheck_from_text(result)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_upright_pendulum_never_certified(seed):
+    result = fossil_dsl.synthesise(spec_text(UPRIGHT), seed=seed, max_iters=3, learn_steps=300)
+    assert not result.certified
+    assert any(c.status == "sat" for c in result.conditions)
+
+
+@pytest.mark.parametrize("layers", ["sigmoid(5), square(5)", "tanh(5), square(5)"])
+def test_transcendental_network_certificate_verified_and_rechecked(layers):
+    spec = spec_text(POLYNOMIAL + f"synthesis {{ certificate: {layers} }}\n")
+    result = fossil_dsl.synthesise(spec, seed=0)
+    assert result.certified, result.reason
+    assert result.plan.verifier == "interval" or registry.is_installed("dreal")
+    recheck_from_text(result)
+
+
+def test_interval_answers_rest_on_outward_rounding():
+    # 1/3 is not a double: x = 1/3 has a solution, which rounding to nearest would lose
+    x = E.Var("x0")
+    third = L.conjunction(L.Compare("<=", E.Num(3) * x, E.ONE),
+                          L.Compare(">=", E.Num(3) * x, E.ONE))
+    assert IntervalBackend().check(third, ["x0"], 10).status is Status.SAT
+    # a gap of about 1e-15 next to an irrational constant is still refuted
+    below_pi = E.lift(3.141592653589793)
+    at_double = L.conjunction(L.Compare(">=", x, E.Pi() + E.lift(1e-15)),
+                              L.Compare("<=", x, below_pi))
+    assert IntervalBackend().check(at_double, ["x0"], 10).status is Status.UNSAT
+    import ctypes
+    import ctypes.util
+    libm = ctypes.CDLL(ctypes.util.find_library("m"))
+    before = libm.fegetround()
+    IntervalBackend().check(third, ["x0"], 10)
+    assert libm.fegetround() == before
+
+
+def test_interval_timeout_is_unknown_not_unsat():
+    x, y = E.Var("x0"), E.Var("x1")
+    # sin(x*y) with huge ranges: far too many boxes for 0.2 s
+    wave = E.apply("sin", E.mul(x, y)) + E.apply("cos", E.mul(x, x))
+    hard = L.conjunction(L.Compare(">", wave, E.lift(1.99999)),
+                         L.Compare("<=", E.mul(x, x) + E.mul(y, y), E.Num(10 ** 6)))
+    answer = IntervalBackend().check(hard, ["x0", "x1"], timeout=0.2)
+    assert answer.status is not Status.UNSAT
+
+
+def test_printed_obligations_read_back_to_the_same_formula():
+    x, y = E.Var("x0"), E.Var("x1")
+    formula = L.conjunction(
+        L.Compare("<=", E.power(x, E.Num(2)) + E.power(y, E.Num(2)), E.ONE),
+        L.negation(L.Compare("<", E.apply("tanh", x) - E.apply("abs", y) / E.Num(3),
+                             E.Pi() * E.apply("atan", y))))
+    read = read_script(query_text(formula, ["x0", "x1"]))
+    assert read.variables == ("x0", "x1")
+    for point in [(0.1, 0.2), (-0.5, 0.3), (0.7, -0.7)]:
+        values = {"x0": E.lift(point[0]), "x1": E.lift(point[1])}
+        for original, again in zip(L.comparisons(formula), L.comparisons(read.formula)):
+            a = enclose(E.substitute(original.left - original.right, values))
+            b = enclose(E.substitute(again.left - again.right, values))
+            assert abs(a[0] - b[0]) < 1e-9
+
+
+def test_check_names_the_verifier_for_a_transcendental_spec(tmp_path):
+    path = tmp_path / "pendulum.fsl"
+    path.write_text(PENDULUM)
+    run = subprocess.run([str(FOSSILC), "check", str(path)], capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == 0
+    expected = "dreal" if registry.is_installed("dreal") else "interval"
+    assert f"  verifier: {expected} (the problem has transcendental functions" in run.stdout
+
+
+@pytest.mark.skipif(registry.is_installed("dreal"), reason="dReal is installed here")
+def test_dreal_named_without_dreal_is_a_clear_error(tmp_path):
+    path = tmp_path / "dreal.fsl"
+    path.write_text(PENDULUM + "synthesis { verifier: dreal }\n")
+    run = subprocess.run([str(FOSSILC), str(path)], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert f"{path}:8:13: error: verifier `dreal` is not available here" in run.stderr
+    assert "available: z3, cvc5, interval" in run.stderr
+
+
+def test_dreal_is_imported_only_when_used():
+    code = ("import sys, fossil_dsl; spec = fossil_dsl.loads(open(sys.argv[1]).read()); "
+            "fossil_dsl.synthesise(spec, max_iters=1, verifier='interval'); "
+            "assert 'dreal' not in sys.modules")
+    path = ROOT / "specs" / "stability_continuous.fsl"
+    run = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
