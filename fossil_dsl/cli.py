@@ -10,10 +10,13 @@ import argparse
 import json
 import os
 import sys
+from pathlib import Path
 from typing import Sequence
 
 from rich.console import Console
+from rich.progress import Progress, TextColumn
 
+import fossil_dsl.bench as bench
 from fossil_dsl.version import __version__
 from fossil_dsl.api import CheckResult, check_file, synthesise
 from fossil_dsl.diagnostics import error
@@ -125,7 +128,7 @@ def _run_parser() -> argparse.ArgumentParser:
         prog="fossilc", description="Check a .fsl spec, learn a certificate (and a "
         "controller) and prove it.",
         epilog="other commands: `fossilc check SPEC...`, `fossilc compile SPEC --emit "
-        "plan|smt2|losses` (each has --help)")
+        "plan|smt2|losses`, `fossilc bench FILES_OR_DIRS` (each has --help)")
     parser.add_argument("spec", help="the .fsl file")
     parser.add_argument("-o", "--output", metavar="DIR",
                         help="write result.json, certificate.txt and obligations/*.smt2")
@@ -164,7 +167,46 @@ def _check_parser() -> argparse.ArgumentParser:
     return parser
 
 
-COMMANDS = {"check": _check_parser, "compile": _compile_parser}
+def command_bench(args: argparse.Namespace) -> int:
+    out, err = _consoles()
+    paths = bench.spec_files(args.paths)
+    if not paths:
+        err.print("fossilc bench: no .fsl files found", style="red")
+        return EXIT_BAD_SPEC
+    total = len(paths) * args.seeds
+    with Progress(*Progress.get_default_columns(), TextColumn("{task.fields[last]}"),
+                  console=err, transient=True) as progress:
+        task = progress.add_task("benchmarks", total=total, last="")
+
+        def advance(run) -> None:
+            progress.update(task, advance=1, last=f"{run.spec} seed {run.seed}: {run.outcome}")
+
+        infos, runs = bench.run_all(paths, args.seeds, args.jobs, args.verifier,
+                                    args.timeout, advance)
+    command = "fossilc bench " + " ".join(sys.argv[2:] if sys.argv[1:2] == ["bench"] else [])
+    runs_csv, table = bench.write(Path(args.out), infos, runs, command.strip())
+    out.print(table.read_text(), markup=False)
+    out.print(f"written: {runs_csv}, {table}, {table.with_suffix('.csv')}", markup=False)
+    return EXIT_OK
+
+
+def _bench_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="fossilc bench",
+                                     description="Run specs with several seeds, each in its "
+                                     "own process, and tabulate success and time.")
+    parser.add_argument("paths", nargs="+", metavar="FILE_OR_DIR", help=".fsl files or folders")
+    parser.add_argument("--seeds", type=int, default=10, help="seeds 0..N-1 (default 10)")
+    parser.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
+    parser.add_argument("--verifier", help="z3, cvc5, dreal or interval (default: per spec)")
+    parser.add_argument("--timeout", type=float, default=600.0,
+                        help="seconds per run (default 600)")
+    parser.add_argument("--out", default="benchmarks/results/latest",
+                        help="folder for runs.csv, table.csv and table.md")
+    parser.set_defaults(handler=command_bench)
+    return parser
+
+
+COMMANDS = {"check": _check_parser, "compile": _compile_parser, "bench": _bench_parser}
 
 
 def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:

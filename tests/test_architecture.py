@@ -21,7 +21,8 @@ ALLOWED = {
     "result": {"version", "ir", "plan", "cegis", "smt"},
     "extend": {"ir", "check", "certificates"},
     "api": {"diagnostics", "ir", "syntax", "check", "plan", "cegis", "result", "smt"},
-    "cli": {"version", "diagnostics", "api", "plan", "result", "smt"},
+    "bench": {"version", "diagnostics", "api", "plan"},
+    "cli": {"version", "diagnostics", "api", "plan", "result", "smt", "bench"},
 }
 
 
