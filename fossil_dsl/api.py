@@ -72,11 +72,13 @@ def check_file(path: str | Path) -> CheckResult:
 def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) -> Result:
     """Compile a checked spec and run CEGIS. `options` override the synthesis block:
     verifier, seed, max_iters, timeout, learning_rate, margin, digits, query_timeout,
-    learn_only (train, report violation rates on fresh samples, prove nothing).
+    delta (precision of a delta-decision verifier), learn_only (train, report violation
+    rates on fresh samples, prove nothing).
     `certificate` is a Certificate subclass to use instead of the registered one."""
     started = time.monotonic()
     plan = compile_spec(spec, certificate=certificate, **options)
-    backend = None if plan.options.learn_only else registry.load(plan.verifier)
+    backend = None if plan.options.learn_only else \
+        registry.load(plan.verifier, plan.options.delta)
     outcome = Cegis(plan, backend, progress).run()
     return build_result(plan, outcome, time.monotonic() - started)
 

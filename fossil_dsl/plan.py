@@ -49,6 +49,7 @@ class RunOptions:
     counterexample_neighbours: int = 20
     control_weight: float = 0.1  # of the control loss (f(x) pointing towards the origin)
     learn_only: bool = False  # train, measure violations on fresh samples, prove nothing
+    delta: float | None = None  # precision of a delta-decision verifier (its default if None)
 
 
 @dataclass(frozen=True)
@@ -163,6 +164,8 @@ def _options(spec: CheckedSpec, overrides: dict) -> RunOptions:
         options = replace(options, learning_rate=float(given.learning_rate))
     if given.margin is not None:
         options = replace(options, margin=float(given.margin))
+    if given.delta is not None:
+        options = replace(options, delta=float(given.delta))
     unknown = set(overrides) - set(RunOptions.__dataclass_fields__)
     if unknown:
         raise TypeError(f"unknown options: {sorted(unknown)}")

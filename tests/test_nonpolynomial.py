@@ -153,3 +153,12 @@ def test_dreal_is_imported_only_when_used():
     run = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
                          text=True, timeout=300)
     assert run.returncode == 0, run.stderr
+
+
+def test_delta_option_reaches_the_verifier():
+    from fossil_dsl.plan import compile_spec
+    spec = spec_text(PENDULUM + "synthesis { delta: 0.001 }\n")
+    plan = compile_spec(spec)
+    assert plan.options.delta == 0.001 and plan.verifier == "interval"
+    assert registry.load("interval", plan.options.delta).delta == 0.001
+    assert registry.load("interval").delta == 1e-4

@@ -51,7 +51,8 @@ def is_installed(name: str) -> bool:
             and importlib.util.find_spec(info.module) is not None)
 
 
-def load(name: str) -> Backend:
+def load(name: str, delta: float | None = None) -> Backend:
+    """The backend called `name`; `delta` sets a delta-decision verifier's precision."""
     info = BACKENDS[name]
     if not is_installed(name):
         others = ", ".join(n for n in BACKENDS if n != name and is_installed(n))
@@ -59,4 +60,5 @@ def load(name: str) -> Backend:
             f"verifier `{name}` is not available on this machine (it needs the Python "
             f"package `{info.requires}`); available: {others}")
     module = importlib.import_module(info.module)
-    return getattr(module, info.class_name)()
+    backend = getattr(module, info.class_name)
+    return backend(delta=delta) if info.delta_decision and delta else backend()
