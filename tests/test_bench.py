@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from fossil_dsl import bench
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -56,3 +58,29 @@ def test_table_rows_use_successful_runs_only():
     assert row[6:] == ["2/3", "2.00", "3.00", "3.00", "4.00", "1.00", "1.50"]
     [empty] = bench.table_rows([info], runs[2:])
     assert empty[6] == "0/1" and empty[7:] == ["–"] * 6
+
+
+BENCHMARKS = ROOT / "specs" / "benchmarks"
+ROWS = [f"row{n:02d}" for n in range(1, 18)] + ["f1_nonpoly0", "f1_poly2", "f1_barr1",
+                                                  "f1_barr3"]
+
+
+def test_the_21_benchmarks_are_there_and_check():
+    files = sorted(BENCHMARKS.glob("*.fsl"))
+    stems = [f.stem for f in files]
+    assert len(files) == 21
+    for row in ROWS:
+        assert sum(stem.startswith(row) for stem in stems) == 1, row
+    run = subprocess.run([str(FOSSILC), "check", *map(str, files)], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    for path in files:
+        assert path.read_text().startswith("# Row") or path.read_text().startswith("# Fossil-1")
+
+
+# a smoke test only: speed is measured by `fossilc bench`, not by tests
+@pytest.mark.parametrize("name", ["row14_stability_dt", "f1_nonpoly0", "row16_safety_dt_two_room"])
+def test_fast_benchmarks_certify_with_one_seed(name):
+    import fossil_dsl
+    result = fossil_dsl.synthesise(fossil_dsl.load(BENCHMARKS / f"{name}.fsl"), seed=0)
+    assert result.certified, result.reason

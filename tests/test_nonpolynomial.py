@@ -114,7 +114,8 @@ def test_printed_obligations_read_back_to_the_same_formula():
     formula = L.conjunction(
         L.Compare("<=", E.power(x, E.Num(2)) + E.power(y, E.Num(2)), E.ONE),
         L.negation(L.Compare("<", E.apply("tanh", x) - E.apply("abs", y) / E.Num(3),
-                             E.Pi() * E.apply("atan", y))))
+                             E.Pi() * E.apply("atan", y))),
+        L.Compare(">", E.apply("log", E.Num(2) + x * x), E.apply("sqrt", E.ONE + y * y)))
     read = read_script(query_text(formula, ["x0", "x1"]))
     assert read.variables == ("x0", "x1")
     for point in [(0.1, 0.2), (-0.5, 0.3), (0.7, -0.7)]:
@@ -162,3 +163,10 @@ def test_delta_option_reaches_the_verifier():
     assert plan.options.delta == 0.001 and plan.verifier == "interval"
     assert registry.load("interval", plan.options.delta).delta == 0.001
     assert registry.load("interval").delta == 1e-4
+
+
+def test_cvc5_says_it_has_no_log():
+    x = E.Var("x0")
+    answer = Cvc5Backend().check(L.Compare(">", E.apply("log", E.Num(2) + x * x), E.ONE),
+                                 ["x0"], timeout=5)
+    assert answer.status is Status.UNKNOWN and "CVC5 has no log" in answer.reason

@@ -7,6 +7,7 @@ from typing import Sequence
 
 import cvc5
 
+from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.smt.api import Answer, Status, UnsupportedTheory
 from fossil_dsl.smt.smtlib import query_text
@@ -16,6 +17,9 @@ class Cvc5Backend:
     name = "cvc5"
 
     def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+        missing = _functions(formula) & NOT_IN_CVC5
+        if missing:
+            return Answer(Status.UNKNOWN, reason="CVC5 has no " + ", ".join(sorted(missing)))
         try:
             text = query_text(formula, variables)
         except UnsupportedTheory as exc:
@@ -44,6 +48,14 @@ class Cvc5Backend:
             model = {v: _rational(value) for v, value in values.items()}
             return Answer(Status.SAT, model, approximate=irrational)
         return Answer(Status.UNKNOWN, reason=str(result.getUnknownExplanation()))
+
+
+NOT_IN_CVC5 = frozenset({"log", "sqrt"})
+
+
+def _functions(formula: L.Formula) -> set[str]:
+    return {node.func for c in L.comparisons(formula) for side in (c.left, c.right)
+            for node in E.walk(side) if isinstance(node, E.Apply)}
 
 
 def _rational(value) -> Fraction:

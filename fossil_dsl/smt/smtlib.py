@@ -14,7 +14,9 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.smt.api import UnsupportedTheory
 
-_FUNCTIONS = {"sin": "sin", "cos": "cos", "tan": "tan", "exp": "exp", "atan": "arctan"}
+_FUNCTIONS = {"sin": "sin", "cos": "cos", "tan": "tan", "exp": "exp", "atan": "arctan",
+              # not in SMT-LIB's theories: dReal's names, which Z3 and CVC5 do not read
+              "log": "log", "sqrt": "sqrt"}
 _MAX_EXPANDED_POWER = 16
 
 
@@ -74,7 +76,7 @@ class Printer:
             twice = f"(exp (* 2.0 {arg}))"
             return f"(/ (- {twice} 1.0) (+ {twice} 1.0))"
         if expr.func not in _FUNCTIONS:
-            raise UnsupportedTheory(f"SMT-LIB 2 (as Z3 and CVC5 read it) has no `{expr.func}`")
+            raise UnsupportedTheory(f"SMT-LIB 2 has no `{expr.func}`")
         return f"({_FUNCTIONS[expr.func]} {arg})"
 
     def formula(self, formula: L.Formula) -> str:

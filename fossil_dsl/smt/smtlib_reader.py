@@ -4,7 +4,7 @@ SMT-LIB front end (the interval verifier) can re-check an exported obligation to
 
 Only the subset the printer emits is accepted: `declare-const`, `define-fun` (numbers
 and functions of the states), one `assert`, real arithmetic, exp/sin/cos/tan/arctan,
-real.pi, and `ite` in the printer's form of abs.
+log/sqrt (dReal's names), real.pi, and `ite` in the printer's form of abs.
 """
 from __future__ import annotations
 
@@ -16,7 +16,8 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 
 _TOKEN = re.compile(r"\s*(?:(;[^\n]*)|(\()|(\))|([^\s()]+))")
-_UNARY = {"exp": "exp", "sin": "sin", "cos": "cos", "tan": "tan", "arctan": "atan"}
+_UNARY = {"exp": "exp", "sin": "sin", "cos": "cos", "tan": "tan", "arctan": "atan",
+          "log": "log", "sqrt": "sqrt"}
 _RELATIONS = ("<", "<=", ">", ">=")
 
 
