@@ -7,9 +7,10 @@ from pathlib import Path
 
 from fossil_dsl.cegis.loop import Cegis
 from fossil_dsl.check.checker import check as _check_tree
-from fossil_dsl.plan import compile_spec
+from fossil_dsl.plan import Plan, compile_spec
 from fossil_dsl.result import Result, build_result
 from fossil_dsl.smt import registry
+from fossil_dsl.smt.fallback import FallbackBackend
 from fossil_dsl.diagnostics import Diagnostic, Source, SpecError, has_errors, render_all
 from fossil_dsl.ir.spec import CheckedSpec
 from fossil_dsl.syntax import ast
@@ -77,10 +78,16 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) ->
     `certificate` is a Certificate subclass to use instead of the registered one."""
     started = time.monotonic()
     plan = compile_spec(spec, certificate=certificate, **options)
-    backend = None if plan.options.learn_only else \
-        registry.load(plan.verifier, plan.options.delta)
+    backend = None if plan.options.learn_only else _backend(plan)
     outcome = Cegis(plan, backend, progress).run()
     return build_result(plan, outcome, time.monotonic() - started)
+
+
+def _backend(plan: Plan):
+    backend = registry.load(plan.verifier, plan.options.delta)
+    if plan.fallback:
+        backend = FallbackBackend(backend, registry.load(plan.fallback, plan.options.delta))
+    return backend
 
 
 def _checked(result: CheckResult) -> CheckedSpec:

@@ -76,6 +76,7 @@ class Plan:
     # conditions that exclude the origin exclude the ball of this radius (a delta-decision
     # verifier cannot refute a closed set that touches the origin, where V = dV = 0)
     origin_radius: Fraction = Fraction(0)
+    fallback: str | None = None  # asked where the verifier gives up (UNKNOWN)
 
     @property
     def states(self) -> tuple[str, ...]:
@@ -102,13 +103,21 @@ def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None
         _check_candidate(spec, function)
     conditions = rule.conditions()
     controller = _controller(spec, rule)
-    verifier, reason = choose_verifier(spec, functions, controller,
-                                       overrides.pop("verifier", None))
+    requested = overrides.pop("verifier", None)
+    verifier, reason = choose_verifier(spec, functions, controller, requested)
     options = _options(spec, overrides)
     samples = {c.name: _sample_count(spec, c.region) for c in conditions}
     radius = ORIGIN_RADIUS if registry.BACKENDS[verifier].delta_decision else Fraction(0)
+    fallback = None if requested or spec.synthesis.verifier else _fallback(verifier)
+    if fallback:
+        reason += f"; where it gives up, {fallback}"
     return Plan(spec, rule, functions, conditions, tuple(rule.levels()), controller,
-                verifier, reason, MappingProxyType(samples), options, radius)
+                verifier, reason, MappingProxyType(samples), options, radius, fallback)
+
+
+def _fallback(verifier: str) -> str | None:
+    """The interval verifier after Z3 (when no verifier is named)."""
+    return "interval" if verifier == "z3" and registry.is_installed("interval") else None
 
 
 def _certificate(spec: CheckedSpec, given: type[Certificate] | None) -> Certificate:

@@ -24,6 +24,7 @@ class ConditionReport:
     status: str  # "unsat" (proved), "sat" (counterexample), "unknown", "not verified"
     reason: str
     counterexample: tuple[Fraction, ...] | None
+    solver: str = ""  # which solver answered
 
 
 @dataclass(frozen=True)
@@ -69,16 +70,16 @@ class Result:
 
     def assumptions(self) -> list[str]:
         plan = self.plan
-        found = [f"every condition was proved by {plan.verifier} (its queries were UNSAT) "
-                 "for the exact formulas shown",
-                 "the conditions are checked only inside the domain D"]
-        info = registry.BACKENDS[plan.verifier]
-        if info.caveat:
-            found.append(info.caveat)
-        if info.delta_decision:
-            found.append(f"{plan.verifier} is a delta-decision procedure: only its UNSAT "
-                         "answers are used as proofs, and it proves the closed (stronger) "
-                         "form of strict inequalities")
+        found = [_provers(self.conditions) + " (its queries were UNSAT) for the exact "
+                 "formulas shown", "the conditions are checked only inside the domain D"]
+        for name in dict.fromkeys(c.solver for c in self.conditions):
+            info = registry.BACKENDS[name]
+            if info.caveat:
+                found.append(info.caveat)
+            if info.delta_decision:
+                found.append(f"{name} is a delta-decision procedure: only its UNSAT "
+                             "answers are used as proofs, and it proves the closed (stronger) "
+                             "form of strict inequalities")
         if any(f.candidate is None for f in plan.functions):
             found.append(f"network weights were rounded to {self.digits} decimals "
                          "before verifying; the rounded function is the one proved")
@@ -106,12 +107,23 @@ class Result:
             "learn_only": self.learn_only,
             "conditions": [_condition_json(c) for c in self.conditions],
             "verifier": plan.verifier,
+            "fallback": plan.fallback,
             "iterations": self.iterations,
             "seed": plan.options.seed,
             "seconds": {"learn": _seconds(self.learn_seconds),
                         "verify": _seconds(self.verify_seconds),
                         "total": _seconds(self.total_seconds)},
         }
+
+
+def _provers(conditions) -> str:
+    by_solver: dict[str, list[str]] = {}
+    for condition in conditions:
+        by_solver.setdefault(condition.solver, []).append(condition.name)
+    if len(by_solver) == 1:
+        return f"every condition was proved by {next(iter(by_solver))}"
+    return "each condition was proved by the solver named: " + "; ".join(
+        f"{solver} ({', '.join(names)})" for solver, names in by_solver.items())
 
 
 def _seconds(value: float) -> float:
@@ -121,14 +133,15 @@ def _seconds(value: float) -> float:
 def _condition_json(report: ConditionReport) -> dict:
     point = [str(v) for v in report.counterexample] if report.counterexample else None
     return {"name": report.name, "text": report.text, "status": report.status,
-            "reason": report.reason, "counterexample": point}
+            "reason": report.reason, "counterexample": point, "solver": report.solver}
 
 
 def build_result(plan: Plan, outcome: CegisOutcome, total_seconds: float) -> Result:
     texts = {c.name: c.text for c in plan.conditions}
     reports = tuple(ConditionReport(v.condition, texts[v.condition],
                                     "not verified" if plan.options.learn_only else v.status.value,
-                                    v.reason, v.counterexample) for v in outcome.verdicts)
+                                    v.reason, v.counterexample, v.solver or plan.verifier)
+                    for v in outcome.verdicts)
     candidate = outcome.candidate
     return Result(plan, outcome.certified, outcome.reason, dict(candidate.formulas),
                   dict(candidate.controller), dict(candidate.levels), reports,
@@ -171,6 +184,8 @@ def summary_text(result: Result) -> str:
     for report in result.conditions:
         mark = {"unsat": "proved", "sat": "fails", "unknown": "unknown",
                 "not verified": "not verified"}[report.status]
+        if report.status == "unsat" and report.solver != plan.verifier:
+            mark += f" by {report.solver}"
         extra = ""
         if report.counterexample:
             extra = " at (" + ", ".join(format(float(v), ".6g") for v in report.counterexample) + ")"

@@ -170,3 +170,38 @@ def test_cvc5_says_it_has_no_log():
     answer = Cvc5Backend().check(L.Compare(">", E.apply("log", E.Num(2) + x * x), E.ONE),
                                  ["x0"], timeout=5)
     assert answer.status is Status.UNKNOWN and "CVC5 has no log" in answer.reason
+
+
+class Scripted:
+    def __init__(self, name, answer):
+        self.name, self.answer, self.calls = name, answer, []
+
+    def check(self, formula, variables, timeout):
+        self.calls.append(timeout)
+        return self.answer
+
+
+def test_fallback_asks_the_second_solver_only_where_the_first_gives_up():
+    from fossil_dsl.smt.api import Answer
+    from fossil_dsl.smt.fallback import FallbackBackend
+    unknown = Answer(Status.UNKNOWN, reason="timeout")
+    first, second = Scripted("z3", unknown), Scripted("interval", Answer(Status.UNSAT))
+    answer = FallbackBackend(first, second).check(L.TRUE, ["x0"], 60)
+    assert answer.status is Status.UNSAT and answer.solver == "interval"
+    assert first.calls == [15] and second.calls == [45]
+    decided = Scripted("z3", Answer(Status.SAT, {"x0": 0}))
+    later = Scripted("interval", Answer(Status.UNSAT))
+    assert FallbackBackend(decided, later).check(L.TRUE, ["x0"], 60).solver == "z3"
+    assert later.calls == []
+    both = FallbackBackend(Scripted("z3", unknown), Scripted("interval", unknown))
+    answer = both.check(L.TRUE, ["x0"], 60)
+    assert answer.status is Status.UNKNOWN and "z3: timeout; interval: timeout" in answer.reason
+
+
+def test_fallback_only_when_no_verifier_is_named():
+    from fossil_dsl.plan import compile_spec
+    spec = spec_text(POLYNOMIAL)
+    assert compile_spec(spec).fallback == "interval"
+    assert compile_spec(spec, verifier="z3").fallback is None
+    assert compile_spec(spec_text(POLYNOMIAL + "synthesis { verifier: z3 }\n")).fallback is None
+    assert compile_spec(spec_text(PENDULUM)).fallback is None

@@ -30,6 +30,7 @@ class Verdict:
     status: Status
     reason: str = ""
     counterexample: tuple | None = None
+    solver: str = ""  # which solver answered (where the backend combines several)
 
 
 @dataclass(frozen=True)
@@ -223,7 +224,7 @@ def _rational(value: float, digits: int) -> Fraction:
 
 def _verdict(name: str, answer: Answer, states) -> Verdict:
     point = tuple(answer.model.get(s, 0) for s in states) if answer.model else None
-    return Verdict(name, answer.status, answer.reason, point)
+    return Verdict(name, answer.status, answer.reason, point, answer.solver)
 
 
 def _failure_reason(verdicts) -> str:

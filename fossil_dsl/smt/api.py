@@ -25,6 +25,7 @@ class Answer:
     # True if the query bounded irrational constants by intervals, or if the model has
     # irrational coordinates that are reported as nearby rationals
     approximate: bool = False
+    solver: str = ""  # which solver answered, where a backend combines several
 
 
 class UnsupportedTheory(FslError):
