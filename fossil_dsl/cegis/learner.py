@@ -137,21 +137,25 @@ class Learner:
 
     # ---- levels ----
     def levels(self) -> dict[str, float]:
-        return {level.name: self.level(level) for level in self.plan.levels}
+        return {level.name: float(torch.as_tensor(self.level(level)).detach())
+                for level in self.plan.levels}
 
-    def level(self, level: Level) -> float:
+    def level(self, level: Level):
+        """The level's value now. A level just under the smallest value on `above`
+        is a tensor that keeps its gradient: a loss that pushes V below it then also
+        pushes that smallest value up, instead of dragging V and the level down
+        together for ever."""
+        above = self.function(level.function, self.samples[level.above])
+        if level.below is None:
+            return above.min() - 2 * self.plan.options.margin if len(above) else 0.0
         with torch.no_grad():
-            above = self.function(level.function, self.samples[level.above])
-            below = self.function(level.function, self.samples[level.below]) \
-                if level.below is not None else None
-        low = float(above.min()) if len(above) else None
-        if below is None:
-            return 0.0 if low is None else low - 2 * self.plan.options.margin
+            below = self.function(level.function, self.samples[level.below])
+        low = float(above.min().detach()) if len(above) else None
         return _between(float(below.max()) if len(below) else None, low)
 
     # ---- loss ----
     def loss(self) -> tuple[torch.Tensor, bool]:
-        levels = self.levels()
+        levels = {level.name: self.level(level) for level in self.plan.levels}
         total, satisfied = torch.zeros((), dtype=torch.float64), True
         for condition in self.plan.conditions:
             points = self.samples[condition.name]

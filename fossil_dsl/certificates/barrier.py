@@ -5,7 +5,7 @@ from fossil_dsl.certificates.base import (Certificate, Condition, change_of, lev
                                           register, value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
-from fossil_dsl.ir.sets import SetExpr
+from fossil_dsl.ir.sets import Complement, Difference, Intersection, SetExpr
 from fossil_dsl.ir.spec import Layer
 
 DEFAULT_LAYERS = (Layer("square", 10),)
@@ -18,9 +18,11 @@ def barrier_conditions(certificate: Certificate, name: str, inside: SetExpr,
     B, dB = value_of(name), change_of(name)
     initial = Condition(f"{prefix}initial", f"{name}(x) <= 0 for every x in {inside_words}",
                         inside, L.Compare("<=", B, E.ZERO))
-    unsafe = Condition(f"{prefix}unsafe", f"{name}(x) > 0 for every x in {outside_words}",
-                       outside, L.Compare(">", B, E.ZERO))
     domain = certificate.spec.domain
+    # only the part of the avoided set inside D matters (the guarantee holds within D),
+    # and it is bounded even where the set is not (e.g. {x0 + x1^2 <= 0})
+    unsafe = Condition(f"{prefix}unsafe", f"{name}(x) > 0 for every x in {outside_words}",
+                       _within(outside, domain), L.Compare(">", B, E.ZERO))
     if certificate.discrete:
         # B(f(x)) - B(x) <= 0 where B(x) <= 0 implies B(f(x)) <= 0: {B <= 0} is invariant
         flow = Condition(f"{prefix}invariance",
@@ -32,6 +34,13 @@ def barrier_conditions(certificate: Certificate, name: str, inside: SetExpr,
                          f"d{name}/dt < 0 for every x in D with {name}(x) = 0", domain,
                          L.Compare("<", dB, E.ZERO), guard=level_set(name))
     return initial, unsafe, flow
+
+
+def _within(region: SetExpr, domain: SetExpr) -> SetExpr:
+    if region is domain or isinstance(region, Complement) or \
+            (isinstance(region, Difference) and region.left is domain):
+        return region  # already inside the domain
+    return Intersection(region, domain)
 
 
 @register
