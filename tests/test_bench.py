@@ -79,7 +79,8 @@ def test_the_21_benchmarks_are_there_and_check():
 
 
 # a smoke test only: speed is measured by `fossilc bench`, not by tests
-@pytest.mark.parametrize("name", ["row14_stability_dt", "f1_nonpoly0", "row16_safety_dt_two_room"])
+@pytest.mark.parametrize("name", ["row14_stability_dt", "f1_nonpoly0", "row16_safety_dt_two_room",
+                                  "f1_barr1"])
 def test_fast_benchmarks_certify_with_one_seed(name):
     import fossil_dsl
     result = fossil_dsl.synthesise(fossil_dsl.load(BENCHMARKS / f"{name}.fsl"), seed=0)

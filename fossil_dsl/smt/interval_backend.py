@@ -9,8 +9,9 @@ boxes of a depth-first search are contracted and bisected:
   interval computation under outward rounding, so the enlarged set, and therefore the
   query, has no point in the box: the answer rests on no floating-point sampling.
 - delta-SAT when a box narrower than `delta` in every direction survives contraction;
-  its midpoint is returned as the counterexample (the query may be false there by at
-  most the interval overestimation: it is a lead for the learner, not a proof).
+  its midpoint is returned as the counterexample (a lead for the learner, not a proof).
+  A box whose midpoint alone is refuted is kept aside while the search looks for one
+  whose midpoint is not; it is returned only if no better one is found.
 - UNKNOWN on timeout, or when contraction cannot bound every variable.
 """
 from __future__ import annotations
@@ -51,7 +52,7 @@ class IntervalBackend:
             return Answer(Status.UNSAT)
         if start.is_unbounded():
             return _unbounded()
-        stack, boxes = [start], 0
+        stack, boxes, unresolved = [start], 0, None
         while stack:
             box = stack.pop()
             boxes += 1
@@ -61,14 +62,31 @@ class IntervalBackend:
             if max(box[i].diam() for i in split) < self.delta:
                 if _contract_to_fixpoint(contractor, box):
                     continue
-                return _delta_sat(box, names, variables, self.delta)
+                if _middle_may_satisfy(contractor, box):
+                    return _delta_sat(box, names, variables, self.delta)
+                # its middle is refuted: look on for a better witness, keep this one
+                unresolved = unresolved or box
+                continue
             if boxes % 256 == 0 and time.monotonic() > deadline:
+                if unresolved is not None:
+                    return _delta_sat(unresolved, names, variables, self.delta)
                 return Answer(Status.UNKNOWN, reason=f"timeout after {boxes} boxes, "
                               f"{len(stack) + 1} left to refute")
             widest = max(split, key=lambda i: box[i].diam())
             first, second = box.bisect(widest, 0.5)
             stack += [second, first]
+        if unresolved is not None:
+            return _delta_sat(unresolved, names, variables, self.delta)
         return Answer(Status.UNSAT)
+
+
+def _middle_may_satisfy(contractor, box) -> bool:
+    """Whether the box's middle point survives contraction: a witness the learner can
+    use, rather than a box that only interval overestimation keeps alive."""
+    middle = box.mid()
+    point = type(box)([[middle[i], middle[i]] for i in range(box.size())])
+    contractor.contract(point)
+    return not point.is_empty()
 
 
 def _worth_splitting(formula: L.Formula, names) -> list[int]:
