@@ -10,8 +10,8 @@ boxes of a depth-first search are contracted and bisected:
   query, has no point in the box: the answer rests on no floating-point sampling.
 - delta-SAT when a box narrower than `delta` in every direction survives contraction;
   its midpoint is returned as the counterexample (a lead for the learner, not a proof).
-  A box whose midpoint alone is refuted is kept aside while the search looks for one
-  whose midpoint is not; it is returned only if no better one is found.
+  A box whose midpoint alone is refuted is kept aside while the search looks (for
+  WITNESS_SEARCH more boxes) for one whose midpoint is not; it is returned if none is.
 - UNKNOWN on timeout, or when contraction cannot bound every variable.
 """
 from __future__ import annotations
@@ -27,6 +27,7 @@ from fossil_dsl.ir.enclosure import rational_interval, upward_rounding
 from fossil_dsl.smt.api import Answer, Status, UnsupportedTheory
 
 DELTA = 1e-4  # the width under which a surviving box counts as a (delta-)solution
+WITNESS_SEARCH = 2000  # boxes searched for a better witness after a doubtful one
 
 
 class IntervalBackend:
@@ -52,10 +53,13 @@ class IntervalBackend:
             return Answer(Status.UNSAT)
         if start.is_unbounded():
             return _unbounded()
-        stack, boxes, unresolved = [start], 0, None
+        stack, boxes, unresolved, since = [start], 0, None, 0
         while stack:
             box = stack.pop()
             boxes += 1
+            since += unresolved is not None
+            if since > WITNESS_SEARCH:
+                return _delta_sat(unresolved, names, variables, self.delta)
             contractor.contract(box)
             if box.is_empty():
                 continue
