@@ -183,8 +183,10 @@ def command_bench(args: argparse.Namespace) -> int:
 
         infos, runs = bench.run_all(paths, args.seeds, args.jobs, args.verifier,
                                     args.timeout, advance)
-    command = "fossilc bench " + " ".join(sys.argv[2:] if sys.argv[1:2] == ["bench"] else [])
-    runs_csv, table = bench.write(Path(args.out), infos, runs, command.strip())
+    command = (f"fossilc bench {' '.join(args.paths)} --seeds {args.seeds} --jobs {args.jobs} "
+               f"--timeout {args.timeout:g} --out {args.out}"
+               + (f" --verifier {args.verifier}" if args.verifier else ""))
+    runs_csv, table = bench.write(Path(args.out), infos, runs, command)
     out.print(table.read_text(), markup=False)
     out.print(f"written: {runs_csv}, {table}, {table.with_suffix('.csv')}", markup=False)
     return EXIT_OK

@@ -205,3 +205,9 @@ def test_fallback_only_when_no_verifier_is_named():
     assert compile_spec(spec, verifier="z3").fallback is None
     assert compile_spec(spec_text(POLYNOMIAL + "synthesis { verifier: z3 }\n")).fallback is None
     assert compile_spec(spec_text(PENDULUM)).fallback is None
+
+
+def test_interval_reports_what_it_cannot_express_as_unknown():
+    formula = L.Compare(">", E.Apply("erf", E.Var("x0")), E.ONE)
+    answer = IntervalBackend().check(formula, ["x0"], timeout=5)
+    assert answer.status is Status.UNKNOWN and "erf" in answer.reason

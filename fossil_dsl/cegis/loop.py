@@ -7,7 +7,7 @@ formulas that are returned with it.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Callable
 
@@ -19,7 +19,7 @@ from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.learn.networks import Network
+from fossil_dsl.learn.networks import Network, rational
 from fossil_dsl.plan import Plan
 from fossil_dsl.smt.api import Answer, Backend, Status
 
@@ -58,13 +58,12 @@ class CegisState:
 
 @dataclass(frozen=True)
 class ExactCandidate:
-    """What is verified: exact formulas for every function, the controller and the
-    closed loop, each function's change along it, and the levels as rationals."""
+    """What is verified: exact formulas for every function and the controller, each
+    function's change along the closed loop, and the levels as rationals."""
 
     formulas: dict[str, E.Expr]
     changes: dict[str, E.Expr]
     controller: dict[str, E.Expr]  # input name -> k_i(x)
-    closed_loop: tuple[E.Expr, ...]
     levels: dict[str, Fraction]
     digits: int  # decimals kept when the weights were rounded
 
@@ -86,7 +85,6 @@ class CegisOutcome:
     learn_seconds: float
     verify_seconds: float
     networks: dict[str, Network]
-    violation_rates: dict[str, tuple[int, int]] | None = None  # learn-only: (fails, of)
 
     @property
     def formulas(self) -> dict[str, E.Expr]:
@@ -159,9 +157,8 @@ class Cegis:
                                  f"{fails} of {total} fresh samples violate it")
                          for name, (fails, total) in rates.items())
         state.history.append(IterationRecord(1, loss, verdicts, learn_seconds, 0.0))
-        return replace(self.outcome(state, False, "learn-only: trained without verifying; "
-                                    "nothing was proved", self.exact_candidate(), {},
-                                    verdicts), violation_rates=rates)
+        return self.outcome(state, False, "learn-only: trained without verifying; nothing "
+                            "was proved", self.exact_candidate(), {}, verdicts)
 
     def outcome(self, state, certified, reason, candidate, queries, verdicts):
         return CegisOutcome(certified, reason, candidate, queries, tuple(verdicts),
@@ -190,8 +187,8 @@ class Cegis:
                                   learner.controller.formulas(self.states, digits)))
         closed_loop = tuple(E.substitute(f, controller) for f in self.plan.spec.dynamics)
         changes = {name: self.change(formula, closed_loop) for name, formula in formulas.items()}
-        levels = {name: _rational(value, digits) for name, value in learner.levels().items()}
-        return ExactCandidate(formulas, changes, controller, closed_loop, levels, digits)
+        levels = {name: rational(value, digits) for name, value in learner.levels().items()}
+        return ExactCandidate(formulas, changes, controller, levels, digits)
 
     def change(self, formula: E.Expr, dynamics) -> E.Expr:
         if self.plan.spec.time is TimeDomain.DISCRETE:
@@ -216,10 +213,6 @@ class Cegis:
                 self.learner.add_counterexample(verdict.condition, verdict.counterexample)
             elif verdict.status is Status.UNKNOWN:  # learn something: more samples there
                 self.learner.add_region_samples(verdict.condition)
-
-
-def _rational(value: float, digits: int) -> Fraction:
-    return Fraction(round(value * 10 ** digits), 10 ** digits)
 
 
 def _verdict(name: str, answer: Answer, states) -> Verdict:

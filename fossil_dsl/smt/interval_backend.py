@@ -40,7 +40,10 @@ class IntervalBackend:
         names = sorted(set(variables) | L.free_vars(formula))
         deadline = time.monotonic() + timeout
         with upward_rounding() as codac:
-            contractor = _Compiler(codac, names).formula(formula)
+            try:
+                contractor = _Compiler(codac, names).formula(formula)
+            except UnsupportedTheory as exc:
+                return Answer(Status.UNKNOWN, reason=str(exc))
             if contractor is None:  # the formula is TRUE: any point
                 return _unbounded() if names else Answer(Status.SAT, {})
             start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
