@@ -5,6 +5,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from fossil_dsl.cegis.learner import import_optimiser_support
 from fossil_dsl.cegis.loop import Cegis
 from fossil_dsl.check.checker import check as _check_tree
 from fossil_dsl.plan import Plan, compile_spec
@@ -76,6 +77,7 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) ->
     delta (precision of a delta-decision verifier), learn_only (train, report violation
     rates on fresh samples, prove nothing).
     `certificate` is a Certificate subclass to use instead of the registered one."""
+    import_optimiser_support()
     started = time.monotonic()
     plan = compile_spec(spec, certificate=certificate, **options)
     backend = None if plan.options.learn_only else _backend(plan)

@@ -3,6 +3,8 @@
     fossilc SPEC.fsl            check, compile and synthesise (exit 0 / 1 / 2)
     fossilc check SPEC...       the static checks only (exit 0 / 2)
     fossilc compile SPEC        the certificate plan, its SMT-LIB queries or its losses
+    fossilc bench FILES_OR_DIRS every spec with several seeds, tabulated
+    fossilc recheck DIR         re-prove a result's obligations with another solver
 """
 from __future__ import annotations
 
@@ -17,10 +19,12 @@ from rich.console import Console
 from rich.progress import Progress, TextColumn
 
 import fossil_dsl.bench as bench
+import fossil_dsl.recheck as recheck
 from fossil_dsl.version import __version__
 from fossil_dsl.api import CheckResult, check_file, synthesise
 from fossil_dsl.diagnostics import error
 from fossil_dsl.plan import CompileError, compile_spec, loss_text, plan_text, symbolic_queries
+from fossil_dsl.plot import PlotError, write_portraits
 from fossil_dsl.result import summary_text, write_artefacts
 from fossil_dsl.smt.registry import BackendUnavailable
 
@@ -80,12 +84,27 @@ def command_run(args: argparse.Namespace) -> int:
         return EXIT_BAD_SPEC
     if args.output:
         write_artefacts(outcome, args.output)
+    if args.plot and not _write_plots(outcome, args, err):
+        return EXIT_BAD_SPEC
     if args.json:
         print(json.dumps(outcome.to_json(), indent=2))
     else:
         style = "bold green" if outcome.certified else "bold red"
         out.print(summary_text(outcome), style=style if args.quiet else None, markup=False)
     return outcome.exit_code
+
+
+def _write_plots(outcome, args: argparse.Namespace, err: Console) -> bool:
+    """phase_portrait.png and .svg in the -o folder, else SPECNAME_portrait.* here."""
+    stem = Path(args.output) / "phase_portrait" if args.output else \
+        Path(f"{outcome.plan.spec.name}_portrait")
+    try:
+        written = write_portraits(outcome, stem)
+    except PlotError as exc:
+        err.print(f"fossilc: {exc}", style="red", markup=False)
+        return False
+    err.print("phase portrait: " + ", ".join(str(p) for p in written), markup=False)
+    return True
 
 
 def _compile_error(exc: Exception, result: CheckResult, err: Console) -> None:
@@ -128,7 +147,7 @@ def _run_parser() -> argparse.ArgumentParser:
         prog="fossilc", description="Check a .fsl spec, learn a certificate (and a "
         "controller) and prove it.",
         epilog="other commands: `fossilc check SPEC...`, `fossilc compile SPEC --emit "
-        "plan|smt2|losses`, `fossilc bench FILES_OR_DIRS` (each has --help)")
+        "plan|smt2|losses`, `fossilc bench FILES_OR_DIRS`, `fossilc recheck DIR` (each has --help)")
     parser.add_argument("spec", help="the .fsl file")
     parser.add_argument("-o", "--output", metavar="DIR",
                         help="write result.json, certificate.txt and obligations/*.smt2")
@@ -139,6 +158,9 @@ def _run_parser() -> argparse.ArgumentParser:
     parser.add_argument("--learn-only", action="store_true",
                         help="train without verifying; report how many fresh samples "
                         "violate each condition (nothing is proved)")
+    parser.add_argument("--plot", action="store_true",
+                        help="draw the phase portrait (2- and 3-state specs) as PNG and SVG: "
+                        "DIR/phase_portrait.* with -o DIR, else SPECNAME_portrait.*")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress, errors only")
     parser.add_argument("--json", action="store_true", help="print result.json on stdout")
     parser.add_argument("--version", action="version", version=f"fossilc {__version__}")
@@ -208,7 +230,33 @@ def _bench_parser() -> argparse.ArgumentParser:
     return parser
 
 
-COMMANDS = {"check": _check_parser, "compile": _compile_parser, "bench": _bench_parser}
+def command_recheck(args: argparse.Namespace) -> int:
+    out, err = _consoles()
+    try:
+        checks = recheck.recheck(args.directory, args.timeout, args.solver)
+    except (recheck.RecheckError, BackendUnavailable) as exc:
+        err.print(f"fossilc recheck: {exc}", style="red", markup=False)
+        return EXIT_BAD_SPEC
+    out.print(recheck.report_text(checks), markup=False)
+    return EXIT_OK if all(c.reproved for c in checks) else 1
+
+
+def _recheck_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="fossilc recheck", description="Re-prove the SMT-LIB 2 obligations of a "
+        "result folder (written by `fossilc SPEC -o DIR`), each with an installed solver "
+        "other than the one that proved it. Exit 0 if every one is re-proved, 1 if not.")
+    parser.add_argument("directory", metavar="DIR", help="the folder `-o DIR` wrote")
+    parser.add_argument("--solver", help="use this solver for every obligation "
+                        "(default: the first suitable one that did not prove it)")
+    parser.add_argument("--timeout", type=float, default=60.0,
+                        help="seconds per obligation (default 60)")
+    parser.set_defaults(handler=command_recheck)
+    return parser
+
+
+COMMANDS = {"check": _check_parser, "compile": _compile_parser, "bench": _bench_parser,
+            "recheck": _recheck_parser}
 
 
 def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:

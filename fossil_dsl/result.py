@@ -3,18 +3,25 @@ certificate.txt and the SMT-LIB 2 proof obligations (one file per condition)."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+import platform
+from importlib import metadata
+from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
+
+import torch
 
 from fossil_dsl.version import __version__
 from fossil_dsl.cegis.loop import CegisOutcome
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir.symbolic import to_sympy
+from fossil_dsl.learn.networks import rational
 from fossil_dsl.plan import Plan
+from fossil_dsl.plot import phase_portrait
 from fossil_dsl.smt import registry
 from fossil_dsl.smt.smtlib import query_text
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2  # docs/result-schema.md; 2 added networks, versions, certificate kind
 
 
 @dataclass(frozen=True)
@@ -42,6 +49,7 @@ class Result:
     verify_seconds: float
     total_seconds: float
     digits: int = 3  # decimals the network weights were rounded to
+    networks: dict = field(default_factory=dict)  # name -> trained torch module ("k": controller)
 
     @property
     def verdict(self) -> str:
@@ -89,6 +97,25 @@ class Result:
         """The text `fossilc` prints: verdict, formulas, conditions, guarantee."""
         return summary_text(self)
 
+    @property
+    def sympy(self) -> dict:
+        """Each function of the certificate (by name) and each controller output (by
+        input name) as an exact sympy expression over real symbols named after the
+        states."""
+        symbols: dict = {}
+        found = {name: to_sympy(f, symbols) for name, f in self.formulas.items()}
+        found.update({u: to_sympy(k, symbols) for u, k in self.controller.items()})
+        return found
+
+    def save(self, directory: str | Path) -> Path:
+        """Write result.json, certificate.txt, obligations/*.smt2 and networks.pt."""
+        return write_artefacts(self, directory)
+
+    def plot(self, path: str | Path | None = None):
+        """The phase portrait (a matplotlib Figure), also written to `path` (.png or
+        .svg) if given. 2- and 3-state specs only."""
+        return phase_portrait(self, path)
+
     def to_json(self) -> dict:
         plan = self.plan
         return {
@@ -97,11 +124,13 @@ class Result:
             "spec": {"name": plan.spec.name, "path": plan.spec.path},
             "property": {"form": plan.spec.property.form, "formula": plan.spec.property.text},
             "certificate": plan.certificate.title,
+            "certificate_kind": type(plan.certificate).__name__,
             "verdict": self.verdict,
             "reason": self.reason,
             "guarantee": self.guarantee(),
             "assumptions": self.assumptions() if self.certified else [],
             "functions": {name: str(f) for name, f in self.formulas.items()},
+            "networks": {name: network_json(n, self.digits) for name, n in self.networks.items()},
             "controller": {name: str(f) for name, f in self.controller.items()},
             "levels": {name: str(v) for name, v in self.levels.items()},
             "learn_only": self.learn_only,
@@ -113,7 +142,37 @@ class Result:
             "seconds": {"learn": _seconds(self.learn_seconds),
                         "verify": _seconds(self.verify_seconds),
                         "total": _seconds(self.total_seconds)},
+            "versions": versions(),
         }
+
+
+def network_json(network, digits: int) -> dict:
+    """A network's layers with every weight and bias as an exact rational ("p/q"): the
+    values that the formulas above were built from."""
+    layers = [{"activation": act.name, **_affine_json(linear, digits)}
+              for linear, act in zip(network.linears, network.activations)]
+    layers.append({"activation": "identity", **_affine_json(network.output, digits)})
+    return {"inputs": network.linears[0].in_features if len(network.linears)
+            else network.output.in_features, "outputs": network.outputs,
+            "subtracts_value_at_origin": network.subtract_origin, "layers": layers}
+
+
+def _affine_json(linear, digits: int) -> dict:
+    weights = [[str(rational(w, digits)) for w in row] for row in linear.weight.tolist()]
+    biases = None if linear.bias is None else \
+        [str(rational(b, digits)) for b in linear.bias.tolist()]
+    return {"weight": weights, "bias": biases}
+
+
+def versions() -> dict[str, str | None]:
+    """The versions of Python and of every package that took part."""
+    found = {"python": platform.python_version(), "fossil_dsl": __version__}
+    for package in ("torch", "z3-solver", "cvc5", "codac", "dreal", "sympy", "lark"):
+        try:
+            found[package] = metadata.version(package)
+        except metadata.PackageNotFoundError:
+            found[package] = None
+    return found
 
 
 def _provers(conditions) -> str:
@@ -146,7 +205,8 @@ def build_result(plan: Plan, outcome: CegisOutcome, total_seconds: float) -> Res
     return Result(plan, outcome.certified, outcome.reason, dict(candidate.formulas),
                   dict(candidate.controller), dict(candidate.levels), reports,
                   obligations(plan, outcome), len(outcome.history), outcome.learn_seconds,
-                  outcome.verify_seconds, total_seconds, candidate.digits)
+                  outcome.verify_seconds, total_seconds, candidate.digits,
+                  dict(outcome.networks))
 
 
 def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
@@ -213,4 +273,7 @@ def write_artefacts(result: Result, directory: str | Path) -> Path:
     (out / "certificate.txt").write_text(summary_text(result) + "\n")
     for name, script in result.obligations.items():
         (out / "obligations" / f"{name}.smt2").write_text(script)
+    if result.networks:
+        torch.save({name: network.state_dict() for name, network in result.networks.items()},
+                   out / "networks.pt")
     return out

@@ -18,11 +18,13 @@ ALLOWED = {
     "plan": {"diagnostics", "ir", "certificates", "smt"},
     "learn": {"ir"},
     "cegis": {"ir", "certificates", "learn", "plan", "smt"},
-    "result": {"version", "ir", "plan", "cegis", "smt"},
+    "plot": {"diagnostics", "ir", "learn"},
+    "result": {"version", "ir", "learn", "plan", "plot", "cegis", "smt"},
+    "recheck": {"diagnostics", "ir", "smt"},
     "extend": {"ir", "check", "certificates"},
     "api": {"diagnostics", "ir", "syntax", "check", "plan", "cegis", "result", "smt"},
     "bench": {"version", "diagnostics", "api", "plan"},
-    "cli": {"version", "diagnostics", "api", "plan", "result", "smt", "bench"},
+    "cli": {"version", "diagnostics", "api", "plan", "result", "smt", "bench", "recheck", "plot"},
 }
 
 

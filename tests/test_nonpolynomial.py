@@ -188,7 +188,7 @@ def test_fallback_asks_the_second_solver_only_where_the_first_gives_up():
     first, second = Scripted("z3", unknown), Scripted("interval", Answer(Status.UNSAT))
     answer = FallbackBackend(first, second).check(L.TRUE, ["x0"], 60)
     assert answer.status is Status.UNSAT and answer.solver == "interval"
-    assert first.calls == [15] and second.calls == [45]
+    assert first.calls == [6] and second.calls == [54]
     decided = Scripted("z3", Answer(Status.SAT, {"x0": 0}))
     later = Scripted("interval", Answer(Status.UNSAT))
     assert FallbackBackend(decided, later).check(L.TRUE, ["x0"], 60).solver == "z3"
@@ -211,3 +211,23 @@ def test_interval_reports_what_it_cannot_express_as_unknown():
     formula = L.Compare(">", E.Apply("erf", E.Var("x0")), E.ONE)
     answer = IntervalBackend().check(formula, ["x0"], timeout=5)
     assert answer.status is Status.UNKNOWN and "erf" in answer.reason
+
+
+def test_fallback_goes_to_the_second_solver_first_for_a_form_it_decided():
+    """CEGIS asks the same condition again with new weights: once the first solver gave
+    up on that form and the second decided it, the second is asked first."""
+    from fossil_dsl.smt.api import Answer
+    from fossil_dsl.smt.fallback import FallbackBackend
+    x = E.Var("x0")
+    query = lambda c: L.Compare("<", E.mul(E.Num(c), x, x), E.ONE)
+    first = Scripted("z3", Answer(Status.UNKNOWN, reason="timeout"))
+    second = Scripted("interval", Answer(Status.UNSAT))
+    backend = FallbackBackend(first, second)
+    backend.check(query(2), ["x0"], 60)
+    assert backend.check(query(3), ["x0"], 60).solver == "interval"
+    assert len(first.calls) == 1 and len(second.calls) == 2
+    backend.check(L.Compare("<", E.add(x, E.ONE), E.ONE), ["x0"], 60)  # another form
+    assert len(first.calls) == 2
+    second.answer = Answer(Status.UNKNOWN, reason="timeout")  # now the second gives up
+    assert backend.check(query(4), ["x0"], 60).status is Status.UNKNOWN
+    assert len(first.calls) == 3  # the first solver was asked again
