@@ -5,6 +5,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from fossil_dsl.build import BespokeSet, BuildError, build_spec, spec_text  # noqa: F401
 from fossil_dsl.cegis.learner import import_optimiser_support
 from fossil_dsl.cegis.loop import Cegis
 from fossil_dsl.check.checker import check as _check_tree

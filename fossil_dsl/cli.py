@@ -5,6 +5,7 @@
     fossilc compile SPEC        the certificate plan, its SMT-LIB queries or its losses
     fossilc bench FILES_OR_DIRS every spec with several seeds, tabulated
     fossilc recheck DIR         re-prove a result's obligations with another solver
+    fossilc import-yaml CONFIG  a Fossil 2.0 YAML configuration as a .fsl spec
 """
 from __future__ import annotations
 
@@ -20,8 +21,9 @@ from rich.progress import Progress, TextColumn
 
 import fossil_dsl.bench as bench
 import fossil_dsl.recheck as recheck
+import fossil_dsl.yaml_import as yaml_import
 from fossil_dsl.version import __version__
-from fossil_dsl.api import CheckResult, check_file, synthesise
+from fossil_dsl.api import CheckResult, check_file, check_text, synthesise
 from fossil_dsl.diagnostics import error
 from fossil_dsl.plan import CompileError, compile_spec, loss_text, plan_text, symbolic_queries
 from fossil_dsl.plot import PlotError, write_portraits
@@ -147,7 +149,7 @@ def _run_parser() -> argparse.ArgumentParser:
         prog="fossilc", description="Check a .fsl spec, learn a certificate (and a "
         "controller) and prove it.",
         epilog="other commands: `fossilc check SPEC...`, `fossilc compile SPEC --emit "
-        "plan|smt2|losses`, `fossilc bench FILES_OR_DIRS`, `fossilc recheck DIR` (each has --help)")
+        "plan|smt2|losses`, `fossilc bench FILES_OR_DIRS`, `fossilc recheck DIR`, `fossilc import-yaml CONFIG.yaml` (each has --help)")
     parser.add_argument("spec", help="the .fsl file")
     parser.add_argument("-o", "--output", metavar="DIR",
                         help="write result.json, certificate.txt and obligations/*.smt2")
@@ -255,8 +257,42 @@ def _recheck_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def command_import_yaml(args: argparse.Namespace) -> int:
+    out, err = _consoles()
+    path = Path(args.config)
+    try:
+        translation = yaml_import.import_yaml(path.read_text("utf-8"), path.stem)
+    except (OSError, UnicodeDecodeError) as exc:
+        err.print(f"fossilc import-yaml: cannot read {path}: {exc}", style="red", markup=False)
+        return EXIT_BAD_SPEC
+    except yaml_import.YamlImportError as exc:
+        err.print(f"fossilc import-yaml: {path}: {exc}", style="red", markup=False)
+        return EXIT_BAD_SPEC
+    for note in translation.notes:
+        err.print(f"{path}: note: {note}", style="yellow", markup=False)
+    target = args.output or "<translated>"
+    if args.output:
+        Path(args.output).write_text(translation.text)
+    else:
+        out.print(translation.text, markup=False, end="")
+    checked = check_text(translation.text, target)
+    _report(checked, out if args.output else err, err, quiet=False, summary=bool(args.output))
+    return EXIT_OK if checked.ok else EXIT_BAD_SPEC
+
+
+def _import_yaml_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="fossilc import-yaml", description="Translate a Fossil 2.0 YAML configuration "
+        "into a .fsl spec, say what could not be translated, and check the result.")
+    parser.add_argument("config", metavar="CONFIG.yaml")
+    parser.add_argument("-o", "--output", metavar="SPEC.fsl",
+                        help="write the spec here (default: print it)")
+    parser.set_defaults(handler=command_import_yaml)
+    return parser
+
+
 COMMANDS = {"check": _check_parser, "compile": _compile_parser, "bench": _bench_parser,
-            "recheck": _recheck_parser}
+            "recheck": _recheck_parser, "import-yaml": _import_yaml_parser}
 
 
 def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:

@@ -22,9 +22,12 @@ ALLOWED = {
     "result": {"version", "ir", "learn", "plan", "plot", "cegis", "smt"},
     "recheck": {"diagnostics", "ir", "smt"},
     "extend": {"ir", "check", "certificates"},
-    "api": {"diagnostics", "ir", "syntax", "check", "plan", "cegis", "result", "smt"},
+    "build": {"diagnostics", "ir", "syntax", "check", "learn"},
+    "api": {"build", "diagnostics", "ir", "syntax", "check", "plan", "cegis", "result", "smt"},
     "bench": {"version", "diagnostics", "api", "plan"},
-    "cli": {"version", "diagnostics", "api", "plan", "result", "smt", "bench", "recheck", "plot"},
+    "cli": {"version", "diagnostics", "api", "plan", "result", "smt", "bench", "recheck", "plot",
+            "yaml_import"},
+    "yaml_import": {"diagnostics", "syntax"},
 }
 
 

@@ -99,10 +99,14 @@ class Learner:
     def field(self, points: torch.Tensor) -> list[torch.Tensor]:
         """The closed-loop vector field (or next state) at the points."""
         env = state_env(self.states, points)
+        inputs = None
         if self.controller is not None:
             inputs = self.controller(points)
             inputs = inputs.unsqueeze(1) if inputs.dim() == 1 else inputs
             env.update({u: inputs[:, i] for i, u in enumerate(self.plan.controller.inputs)})
+        if self.plan.spec.torch_dynamics is not None:
+            values = self.plan.spec.torch_dynamics(points, inputs)
+            return list(torch.as_tensor(values, dtype=torch.float64).unbind(1))
         return [torch.as_tensor(evaluate(f, env), dtype=torch.float64).expand(len(points))
                 for f in self.plan.spec.dynamics]
 
@@ -300,11 +304,11 @@ def _shortfall(condition: Condition, env, margin) -> torch.Tensor:
 
 def _met(shortfall: torch.Tensor, guard: L.Formula, env) -> bool:
     """Whether the condition is met on the samples where its guard holds exactly. A
-    guard that holds exactly on no sample (a level set, B(x) = 0) is judged on a band a
-    tenth as wide as the one trained on."""
+    guard that holds exactly on no sample (a level set, B(x) = 0) is judged on the band
+    trained on."""
     mask = guard_mask(guard, env, len(shortfall), 0.0)
     if not mask.any():
-        mask = guard_mask(guard, env, len(shortfall), GUARD_BAND / 10)
+        mask = guard_mask(guard, env, len(shortfall), GUARD_BAND)
     return bool((shortfall[mask] == 0).all())
 
 

@@ -7,7 +7,7 @@ in SHAPES; the checker and the solvers need no other change.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Sequence
+from typing import Callable, ClassVar, Sequence
 
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import enclose, sign
@@ -56,6 +56,10 @@ class SetExpr:
 
     def text(self) -> str:
         raise NotImplementedError
+
+    def own_samples(self, count: int, generator):
+        """Points of the set from a sampler of its own, or None to sample its box."""
+        return None
 
 
 # ---- shapes ---------------------------------------------------------------------
@@ -201,6 +205,23 @@ class Semialgebraic(SetExpr):
         return "{ " + ", ".join(str(c) for c in self.constraints) + " }"
 
 
+@dataclass(frozen=True, eq=False)
+class Bespoke(Semialgebraic):
+    """A set given in Python (the reference's "bespoke domains"): its constraints for
+    the solvers and the checker, and a sampler of its own for the learner.
+    `sampler(count, generator)` returns a (count, states) tensor of points in the set."""
+
+    name: str = ""
+    sampler: Callable | None = None
+    box: Bounds | None = None
+
+    def bounding_box(self):
+        return self.box
+
+    def own_samples(self, count: int, generator):
+        return self.sampler(count, generator)
+
+
 @dataclass(frozen=True)
 class Union(SetExpr):
     left: SetExpr
@@ -277,6 +298,9 @@ class Named(SetExpr):
 
     def membership(self, point):
         return self.value.membership(point)
+
+    def own_samples(self, count: int, generator):
+        return self.value.own_samples(count, generator)
 
     def text(self):
         return self.name

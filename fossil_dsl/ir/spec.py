@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from fractions import Fraction
 from types import MappingProxyType
-from typing import Mapping
+from typing import Callable, Mapping
 
 from fossil_dsl.diagnostics import Span
 from fossil_dsl.ir.expr import Expr
@@ -90,6 +90,9 @@ class CheckedSpec:
     property: Property
     synthesis: SynthesisOptions
     spans: Mapping[str, Span]  # "state:x0", "set:init", "option:verifier", "prove", ...
+    # for specs built in Python: the field as a torch function (points, inputs) -> values,
+    # used for learning only; every proof uses `dynamics`
+    torch_dynamics: Callable | None = None
 
     @property
     def has_controller(self) -> bool:

@@ -18,6 +18,9 @@ def sample(region: SetExpr, states: Sequence[str], count: int, generator: torch.
     """Up to `count` points of `region` (fewer if the set is very thin in its box)."""
     if isinstance(region, Boundary):
         return _boundary(region.inner, states, count, generator, fallback_box)
+    own = region.own_samples(count, generator)
+    if own is not None:
+        return torch.as_tensor(own, dtype=torch.float64).reshape(-1, len(states))[:count]
     box = region.bounding_box() or fallback_box
     if box is None:
         raise ValueError(f"cannot sample {region}: no bounding box")

@@ -130,7 +130,7 @@ def _grammar_text() -> str:
 def _lark() -> Lark:
     parser = Lark(_grammar_text(), parser="lalr", lexer="contextual", postlex=BracketTracker(),
                   propagate_positions=True, maybe_placeholders=True,
-                  start=["start", "formula"])
+                  start=["start", "formula", "expr"])
     parser.options.postlex.keywords = {
         t.pattern.value: t.name for t in parser.terminals
         if t.pattern.type == "str" and re.fullmatch(r"[A-Za-z_]\w*", t.pattern.value)}
@@ -200,6 +200,19 @@ def parse_formula(text: str) -> ast.Formula:
     except (BracketError, lark.exceptions.UnexpectedInput) as exc:
         diagnostic = getattr(exc, "diagnostic", None) or describe_syntax_error(exc, source)
         raise SpecSyntaxError([diagnostic], source) from None
+    return ToAst().transform(tree)
+
+
+def parse_expression(text: str, path: str = "<expression>") -> ast.Expr:
+    """One expression alone, e.g. `x1 - x0**3` (used to import other tools' configs);
+    raises SpecSyntaxError if the text is anything else."""
+    source = Source(path, text)
+    try:
+        tree = _lark().parse(text, start="expr")
+    except (BracketError, lark.exceptions.UnexpectedInput) as exc:
+        diagnostic = getattr(exc, "diagnostic", None) or describe_syntax_error(exc, source)
+        raise SpecSyntaxError([diagnostic], source) from None
+    _check_depth(tree, source)
     return ToAst().transform(tree)
 
 
