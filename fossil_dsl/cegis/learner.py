@@ -201,7 +201,8 @@ class Learner:
 
     def condition_loss(self, condition: Condition, points: torch.Tensor, env):
         """The mean shortfall, with the plan's margin, where the guard holds (within a
-        band), and whether the samples meet the condition with half that margin."""
+        band), and whether the samples meet the condition: with half that margin where the
+        guard holds, or, for an escapable guard, with the margin on the whole band."""
         margin = self.plan.options.margin
         if condition.scaled_margin:
             margin = margin * (points ** 2).sum(1).detach()
@@ -209,7 +210,10 @@ class Learner:
         if not mask.any():
             return torch.zeros((), dtype=torch.float64), True
         shortfall = _shortfall(condition, env, margin)
-        met = _met(_shortfall(condition, env, margin / 2).detach(), condition.guard, env)
+        if condition.escapable_guard:  # a point may meet it by leaving the guard's band
+            met = bool((shortfall[mask] == 0).all())
+        else:
+            met = _met(_shortfall(condition, env, margin / 2).detach(), condition.guard, env)
         return shortfall[mask].mean(), met
 
     def control_loss(self) -> torch.Tensor:

@@ -28,7 +28,7 @@ def barrier_conditions(certificate: Certificate, name: str, inside: SetExpr,
         flow = Condition(f"{prefix}invariance",
                          f"{name}(f(x)) <= 0 for every x in D with {name}(x) <= 0", domain,
                          L.Compare("<=", E.add(dB, B), E.ZERO),
-                         guard=L.Compare("<=", B, E.ZERO))
+                         guard=L.Compare("<=", B, E.ZERO), escapable_guard=True)
     else:
         flow = Condition(f"{prefix}flow",
                          f"d{name}/dt < 0 for every x in D with {name}(x) = 0", domain,
