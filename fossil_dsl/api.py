@@ -5,7 +5,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from fossil_dsl.build import BespokeSet, BuildError, build_spec, spec_text  # noqa: F401
+from fossil_dsl.build import BespokeSet, BuildError, build_spec, spec_text
 from fossil_dsl.cegis.learner import import_optimiser_support
 from fossil_dsl.cegis.loop import Cegis
 from fossil_dsl.check.checker import check as _check_tree
@@ -17,6 +17,10 @@ from fossil_dsl.diagnostics import Diagnostic, Source, SpecError, has_errors, re
 from fossil_dsl.ir.spec import CheckedSpec
 from fossil_dsl.syntax import ast
 from fossil_dsl.syntax.parser import parse_source, read_source
+
+# re-exported: specs built in Python are part of this API
+__all__ = ["BespokeSet", "BuildError", "CheckResult", "build_spec", "check_file",
+           "check_source", "check_text", "load", "loads", "parse", "spec_text", "synthesise"]
 
 
 @dataclass(frozen=True)

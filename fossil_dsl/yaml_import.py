@@ -76,7 +76,7 @@ class _Importer:
         time = str(self.config.get("TIME_DOMAIN", "CONTINUOUS")).lower()
         if time not in ("continuous", "discrete"):
             raise YamlImportError(f"TIME_DOMAIN: {time!r} is neither CONTINUOUS nor DISCRETE")
-        lines = [f"# Imported from a Fossil 2.0 YAML configuration by `fossilc import-yaml`.",
+        lines = ["# Imported from a Fossil 2.0 YAML configuration by `fossilc import-yaml`.",
                  f"spec {self.name}", "", f"state {', '.join(states)}"]
         if inputs:
             lines.append(f"input {', '.join(inputs)}")

@@ -5,6 +5,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import torch
 
 import fossil_dsl
 from fossil_dsl.cegis.loop import Cegis
@@ -188,3 +189,21 @@ def test_candidate_must_vanish_at_the_origin(tmp_path):
     run = subprocess.run([str(FOSSILC), str(path)], capture_output=True, text=True, timeout=120)
     assert run.returncode == 2
     assert f"{path}:8:13: error: the candidate V must be 0 at the origin" in run.stderr
+
+
+# ---- when training stops: the samples meet every condition -----------------------------
+def test_training_stops_when_the_exact_guard_samples_meet_the_condition():
+    """A sample in the band round the guard (B slightly > 0) is trained on but need not
+    meet the condition: it may be a point where no certificate can meet it."""
+    from fossil_dsl.cegis.learner import _met
+    from fossil_dsl.certificates.base import level_set
+    from fossil_dsl.ir import expr as E
+    from fossil_dsl.ir import logic as L
+    env = {"$B": torch.tensor([-1.0, 0.05, -0.5], dtype=torch.float64)}
+    inside = L.Compare("<=", E.Var("$B"), E.ZERO)
+    assert _met(torch.tensor([0.0, 0.3, 0.0]), inside, env)
+    assert not _met(torch.tensor([0.0, 0.0, 0.2]), inside, env)
+    # B = 0 holds exactly on no sample: judged on the band instead
+    env = {"$B": torch.tensor([0.001, -0.002, 0.8], dtype=torch.float64)}
+    assert not _met(torch.tensor([0.1, 0.0, 0.0]), level_set("B"), env)
+    assert _met(torch.tensor([0.0, 0.0, 0.5]), level_set("B"), env)
