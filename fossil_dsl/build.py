@@ -67,6 +67,9 @@ def build_spec(name: str, states: Sequence, dynamics: Sequence, domain: SetLike,
     inputs)`, if given, returns the field for learning as a (batch, states) tensor; it
     must agree with `dynamics`. Raises SpecError (with diagnostics) or BuildError."""
     state_names, input_names = _names(states), _names(inputs)
+    if isinstance(domain, BespokeSet) and domain.box is None:
+        raise BuildError("a bespoke domain needs a `box` (low, high): the learner samples "
+                         "the other sets and the domain's boundary within it")
     sets = dict(sets or {})
     bespoke = {key: value for key, value in {"domain": domain, **sets}.items()
                if isinstance(value, BespokeSet)}

@@ -306,3 +306,10 @@ def test_yaml_with_python_tags_is_refused(tmp_path):
     run = fossilc("import-yaml", path)
     assert run.returncode == 2 and "not valid YAML" in run.stderr
     assert "Traceback" not in run.stderr
+
+
+def test_a_bespoke_domain_without_a_box_is_refused():
+    class Anywhere(Disc):
+        box = None
+    with pytest.raises(fossil_dsl.BuildError, match="needs a `box`"):
+        built(domain=Anywhere())
