@@ -207,3 +207,46 @@ def test_training_stops_when_the_exact_guard_samples_meet_the_condition():
     env = {"$B": torch.tensor([0.001, -0.002, 0.8], dtype=torch.float64)}
     assert not _met(torch.tensor([0.1, 0.0, 0.0]), level_set("B"), env)
     assert _met(torch.tensor([0.0, 0.0, 0.5]), level_set("B"), env)
+
+
+def _lyapunov_learner(dynamics: str):
+    from fossil_dsl.cegis.learner import Learner
+    spec = spec_text(f"spec s\nstate x0, x1\ndynamics continuous {{\n{dynamics}\n}}\n"
+                     "domain ball([0, 0], 1)\nprove stable\n")
+    plan = compile_spec(spec)
+    torch.manual_seed(0)
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    with torch.no_grad():  # V = a positive sum of squares: dV/dt = 2V or -2V below
+        learner.networks["V"].output.weight.abs_()
+    return learner, plan
+
+
+def _lie_derivative(network, points, field):
+    points = points.clone().requires_grad_(True)
+    grad, = torch.autograd.grad(network(points).sum(), points)
+    return (grad * field(points)).sum(1)
+
+
+def test_violating_samples_are_added_worst_first_and_only_those():
+    """Samples that violate a condition exactly are certain counterexamples: the
+    learner keeps the worst of them (by its own check, confirmed here by autograd) and
+    reports when there is none."""
+    from fossil_dsl.cegis.learner import FRESH_KEPT
+    learner, plan = _lyapunov_learner("x0' = x0\n x1' = x1")  # V cannot decrease
+    decrease = next(c for c in plan.conditions if c.name == "decrease")
+    grid = torch.cartesian_prod(*[torch.linspace(-0.7, 0.7, 41, dtype=torch.float64)] * 2)
+    grid = grid[grid.norm(dim=1) > 1e-6]
+    change = _lie_derivative(learner.networks["V"], grid, lambda p: p)
+    before = len(learner.samples["decrease"])
+    assert learner._keep_violators(decrease, grid, {})
+    added = learner.samples["decrease"][before:]
+    assert len(added) == min(FRESH_KEPT, int((change >= 0).sum()))
+    added_change = _lie_derivative(learner.networks["V"], added, lambda p: p)
+    assert (added_change >= 0).all()
+    assert float(added_change.min()) >= float(change.sort(descending=True).values[len(added) - 1]) - 1e-12
+    stable, plan = _lyapunov_learner("x0' = -x0\n x1' = -x1")  # V decreases everywhere
+    decrease = next(c for c in plan.conditions if c.name == "decrease")
+    assert (_lie_derivative(stable.networks["V"], grid, lambda p: -p) < 0).all()
+    before = len(stable.samples["decrease"])
+    assert not stable._keep_violators(decrease, grid, {})
+    assert len(stable.samples["decrease"]) == before

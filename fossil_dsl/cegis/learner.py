@@ -21,6 +21,10 @@ from fossil_dsl.plan import Plan
 
 GUARD_BAND = 0.1  # a guard such as B(x) = 0 is learned on a band this wide (relative)
 EXTRA_DIGITS = 3  # decimals that rounding may add to the plan's when 3 undo the learning
+FRESH_FACTOR = 4  # fresh samples drawn to look for violations, per training sample
+FRESH_KEPT = 50  # violating fresh samples added per condition and search, the worst first
+FRESH_SEARCHES = 5  # searches of fresh samples per training round, at most
+LOCAL_SEARCH = 2000  # points drawn near a counterexample to find the violations near it
 
 
 def import_optimiser_support() -> None:
@@ -88,6 +92,42 @@ class Learner:
         if len(extra) == 1:  # a set of measure zero (a boundary): weigh the point itself
             extra = extra.repeat(5, 1)
         self.samples[name] = torch.cat([self.samples[name], extra])
+        # a counterexample often sits in a thin sliver of violations: look for the rest
+        nearby = around(centre, condition.region, self.states, LOCAL_SEARCH, 0.05 * scale,
+                        self.generator)
+        levels = {level.name: self.level(level) for level in self.plan.levels}
+        self._keep_violators(condition, nearby, levels)
+
+    def add_fresh_violators(self) -> bool:
+        """Draw fresh samples for every condition and keep those that violate it exactly:
+        each is a certain counterexample, found without a solver. Whether any was found."""
+        levels = {level.name: self.level(level) for level in self.plan.levels}
+        found = False
+        for condition in self.plan.conditions:
+            count = FRESH_FACTOR * self.plan.samples[condition.name]
+            points = sample(condition.region, self.states, count, self.generator, self.box)
+            found = self._keep_violators(condition, points, levels) or found
+        return found
+
+    def _keep_violators(self, condition: Condition, points: torch.Tensor, levels) -> bool:
+        """Add to the condition's samples the points (the worst FRESH_KEPT) where its
+        guard holds and its claim does not, with no margin. Whether there was one."""
+        if condition.exclude_origin:
+            points = points[points.norm(dim=1) > 1e-6]
+        if not len(points):
+            return False
+        points = points.clone().requires_grad_(True)
+        env = self.environment(condition, points, levels)
+        env = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
+        violation = torch.as_tensor(violation_of(condition.claim, env),
+                                    dtype=torch.float64).expand(len(points))
+        bad = (violation > 0) & guard_mask(condition.guard, env, len(points), 0.0)
+        if not bad.any():
+            return False
+        worst = violation[bad].argsort(descending=True)[:FRESH_KEPT]
+        self.samples[condition.name] = torch.cat([self.samples[condition.name],
+                                                  points.detach()[bad][worst]])
+        return True
 
     def add_region_samples(self, name: str, count: int = 100) -> None:
         """After UNKNOWN: learn more about the whole region the query was about."""
@@ -224,12 +264,17 @@ class Learner:
         return torch.nn.functional.cosine_similarity(points, field, dim=1, eps=1e-9).mean()
 
     def train(self, steps: int, deadline: float) -> float:
-        loss_value = 0.0
+        loss_value, searches = 0.0, 0
         for _ in range(steps):
             loss, satisfied = self.loss()
             loss_value = float(loss.detach())
-            if satisfied or time.monotonic() > deadline:
+            if time.monotonic() > deadline:
                 break
+            if satisfied:
+                if searches == FRESH_SEARCHES or not self.add_fresh_violators():
+                    break
+                searches += 1
+                continue
             self.optimiser.zero_grad()
             loss.backward()
             _clip_gradients(self.parameters, 10.0)
