@@ -251,3 +251,32 @@ def test_violating_samples_are_added_worst_first_and_only_those():
     before = len(stable.samples["decrease"])
     assert not stable._keep_violators(decrease, grid, {})
     assert len(stable.samples["decrease"]) == before
+
+
+def test_a_run_that_brings_no_new_counterexample_is_stalled():
+    from fossil_dsl.cegis.loop import STALL_ITERATIONS, IterationRecord, Verdict, _stalled
+
+    def record(i, *found):
+        verdicts = tuple(Verdict(name, Status.SAT, "", point) for name, point in found)
+        return IterationRecord(i, 0.0, verdicts + (Verdict("other", Status.UNSAT),), 0.0, 0.0)
+
+    a, b, c = ("unsafe", (28, 28)), ("initial", (17, 17)), ("unsafe", (27, 28))
+    alternating = [record(1, a), record(2, b)] + [record(3 + i, (a, b)[i % 2])
+                                                  for i in range(STALL_ITERATIONS)]
+    assert _stalled(alternating)
+    assert not _stalled(alternating[:-1])
+    assert not _stalled(alternating + [record(9, c)])        # a new one: progress
+    assert not _stalled([record(i) for i in range(5)])      # nothing failed with SAT
+    repeated = [record(i, a) for i in range(STALL_ITERATIONS + 1)]
+    assert _stalled(repeated) and not _stalled(repeated[1:])
+
+
+def test_restart_draws_new_weights_and_keeps_the_samples():
+    learner, _ = _lyapunov_learner("x0' = -x0\n x1' = -x1")
+    learner.add_counterexample("decrease", (0.5, 0.25))
+    samples = {k: v.clone() for k, v in learner.samples.items()}
+    before = [p.detach().clone() for p in learner.parameters]
+    learner.restart()
+    assert all(not torch.equal(a, b) for a, b in zip(before, learner.parameters))
+    assert all(torch.equal(samples[k], learner.samples[k]) for k in samples)
+    assert learner.optimiser.param_groups[0]["params"] == learner.parameters

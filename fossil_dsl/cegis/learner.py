@@ -61,6 +61,16 @@ class Learner:
         self.optimiser = torch.optim.Adam(self.parameters, lr=plan.options.learning_rate) \
             if self.parameters else None
 
+    def restart(self) -> None:
+        """New initial weights for every network, and a new optimiser; the samples (with
+        every counterexample so far) are kept."""
+        for module in self.modules():
+            for layer in module.modules():
+                if isinstance(layer, torch.nn.Linear):
+                    layer.reset_parameters()
+        self.optimiser = torch.optim.Adam(self.parameters, lr=self.plan.options.learning_rate)
+        self.digits = self.plan.options.digits
+
     def modules(self) -> list[Network]:
         return list(self.networks.values()) + ([self.controller] if self.controller else [])
 

@@ -127,6 +127,7 @@ class Cegis:
     def _run(self) -> CegisOutcome:
         state = CegisState()
         reason = f"gave up after {self.options.max_iters} iterations"
+        restarted = 0  # iterations before the last restart of the learner
         for state.iteration in range(1, self.options.max_iters + 1):
             loss, learn_seconds = self.learn(state)
             candidate = self.exact_candidate()
@@ -143,6 +144,9 @@ class Cegis:
                 return self.outcome(state, False, _failure_reason(verdicts), candidate,
                                     queries, verdicts)
             self.learn_from(verdicts)
+            if _stalled(state.history[restarted:]):  # stuck where it cannot meet them
+                self.learner.restart()
+                restarted = len(state.history)
             if time.monotonic() > self.deadline:
                 reason = f"timeout after {self.options.timeout:g} s"
                 break
@@ -213,6 +217,29 @@ class Cegis:
                 self.learner.add_counterexample(verdict.condition, verdict.counterexample)
             elif verdict.status is Status.UNKNOWN:  # learn something: more samples there
                 self.learner.add_region_samples(verdict.condition)
+
+
+STALL_ITERATIONS = 3  # iterations bringing no new counterexample before a restart
+
+
+def _stalled(history: list[IterationRecord]) -> bool:
+    """Whether each of the last STALL_ITERATIONS iterations failed only with
+    counterexamples met before (since the last restart): the learner cannot meet them
+    from where it is, and more of the same will not help."""
+    if len(history) < STALL_ITERATIONS:
+        return False
+    seen: set = set()
+    repeats = 0
+    for record in history:
+        found = _counterexamples(record)
+        repeats = repeats + 1 if found and found <= seen else 0
+        seen |= found
+    return repeats >= STALL_ITERATIONS
+
+
+def _counterexamples(record: IterationRecord) -> frozenset:
+    return frozenset((v.condition, v.counterexample) for v in record.verdicts
+                     if v.status is Status.SAT)
 
 
 def _verdict(name: str, answer: Answer, states) -> Verdict:
