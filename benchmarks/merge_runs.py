@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from fossil_dsl.bench import Run, describe, write
@@ -18,17 +19,17 @@ def read_runs(path: Path) -> list[Run]:
         for row in csv.DictReader(handle):
             spec_path = ROOT / "specs" / "benchmarks" / Path(row["path"]).name
             numbers = {k: float(row[k]) if row[k] else None for k in ("total", "learn", "verify")}
+            iterations = int(row["iterations"]) if row["iterations"] else None
             runs.append(Run(row["spec"], str(spec_path.relative_to(ROOT)), int(row["seed"]),
-                            row["outcome"], iterations=int(row["iterations"]) if row["iterations"] else None,
-                            wall=float(row["wall"]), detail=row["detail"], **numbers))
+                            row["outcome"], iterations=iterations, wall=float(row["wall"]),
+                            detail=row["detail"], **numbers))
     return runs
 
 
 def main(out: str, sources: list[str]) -> None:
     runs = [run for source in sources for run in read_runs(Path(source))]
     paths = sorted({run.path for run in runs})
-    infos = [describe(ROOT / path, None) for path in paths]
-    infos = [info.__class__(**{**info.__dict__, "path": path}) for info, path in zip(infos, paths)]
+    infos = [replace(describe(ROOT / path, None), path=path) for path in paths]
     write(Path(out), infos, runs, "merged from " + ", ".join(sources))
 
 

@@ -105,13 +105,12 @@ class Learner:
         # a counterexample often sits in a thin sliver of violations: look for the rest
         nearby = around(centre, condition.region, self.states, LOCAL_SEARCH, 0.05 * scale,
                         self.generator)
-        levels = {level.name: self.level(level) for level in self.plan.levels}
-        self._keep_violators(condition, nearby, levels)
+        self._keep_violators(condition, nearby, self.levels())
 
     def add_fresh_violators(self) -> bool:
         """Draw fresh samples for every condition and keep those that violate it exactly:
         each is a certain counterexample, found without a solver. Whether any was found."""
-        levels = {level.name: self.level(level) for level in self.plan.levels}
+        levels = self.levels()
         found = False
         for condition in self.plan.conditions:
             count = FRESH_FACTOR * self.plan.samples[condition.name]
@@ -126,9 +125,7 @@ class Learner:
             points = points[points.norm(dim=1) > 1e-6]
         if not len(points):
             return False
-        points = points.clone().requires_grad_(True)
-        env = self.environment(condition, points, levels)
-        env = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
+        env = self.detached_environment(condition, points, levels)
         violation = torch.as_tensor(violation_of(condition.claim, env),
                                     dtype=torch.float64).expand(len(points))
         bad = (violation > 0) & guard_mask(condition.guard, env, len(points), 0.0)
@@ -136,8 +133,13 @@ class Learner:
             return False
         worst = violation[bad].argsort(descending=True)[:FRESH_KEPT]
         self.samples[condition.name] = torch.cat([self.samples[condition.name],
-                                                  points.detach()[bad][worst]])
+                                                  points[bad][worst]])
         return True
+
+    def detached_environment(self, condition: Condition, points: torch.Tensor, levels) -> dict:
+        """The condition's values at the points, for judging, not training."""
+        env = self.environment(condition, points.clone().requires_grad_(True), levels)
+        return {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
 
     def add_region_samples(self, name: str, count: int = 100) -> None:
         """After UNKNOWN: learn more about the whole region the query was about."""
@@ -320,10 +322,8 @@ class Learner:
                             generator, self.box)
             if condition.exclude_origin:
                 points = points[points.norm(dim=1) > 1e-9]
-            points = points.clone().requires_grad_(True)
-            env = self.environment(condition, points, levels)
+            env = self.detached_environment(condition, points, levels)
             considered = guard_mask(condition.guard, env, len(points), GUARD_BAND)
-            env = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
             fails = ~holds(condition.claim, env, len(points)) & considered
             rates[condition.name] = (int(fails.sum()), int(considered.sum()))
         return rates
