@@ -34,3 +34,30 @@ def test_polynomial_activations_give_polynomials():
         formula = network.formula(("x0", "x1"), digits=3)
         assert E.is_arithmetic(formula) == (activation.polynomial_degree is not None
                                             or name == "relu")
+
+
+def test_centred_network_sees_offset_inputs_as_a_plain_one_sees_the_origin():
+    torch.manual_seed(3)
+    plain = Network(2, [Layer("square", 4)], zero_at_origin=False)
+    torch.manual_seed(3)
+    centred = Network(2, [Layer("square", 4)], zero_at_origin=False, centre=[20.0, 20.0])
+    offset = torch.tensor([[20.5, 19.0], [20.0, 20.0]], dtype=torch.float64)
+    assert torch.allclose(centred(offset), plain(offset - 20.0))
+    # the exact formula is the same function (the centring is in the biases)
+    x = {"x0": offset[:, 0], "x1": offset[:, 1]}
+    exact = evaluate(centred.formula(["x0", "x1"], 12), x)
+    assert torch.allclose(torch.as_tensor(exact, dtype=torch.float64), centred(offset))
+    centred.reset()
+    first = centred.linears[0]
+    assert torch.allclose(first.bias + first.weight @ torch.tensor([20.0, 20.0],
+                          dtype=torch.float64), torch.zeros(4, dtype=torch.float64), atol=1.0)
+
+
+def test_centring_leaves_networks_on_domains_around_the_origin_and_without_biases_alone():
+    torch.manual_seed(5)
+    plain = Network(2, [Layer("tanh", 3)], zero_at_origin=False)
+    torch.manual_seed(5)
+    centred = Network(2, [Layer("tanh", 3)], zero_at_origin=False, centre=[0.0, 0.0])
+    assert all(torch.equal(a, b) for a, b in zip(plain.parameters(), centred.parameters()))
+    no_bias = Network(2, [Layer("square", 3)], zero_at_origin=True, centre=[20.0, 20.0])
+    assert no_bias(torch.zeros(1, 2, dtype=torch.float64)).item() == 0.0

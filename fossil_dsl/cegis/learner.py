@@ -7,6 +7,7 @@ hands those to the verifier.
 from __future__ import annotations
 
 import copy
+import math
 import time
 
 import torch
@@ -41,7 +42,9 @@ class Learner:
         self.states = plan.states
         self.generator = generator
         self.box = plan.spec.domain.bounding_box()
-        self.networks = {f.name: Network(len(self.states), f.layers, f.zero_at_origin)
+        centre = _box_centre(self.box)
+        self.networks = {f.name: Network(len(self.states), f.layers, f.zero_at_origin,
+                                         centre=centre)
                          for f in plan.functions if f.candidate is None}
         self.candidates = {f.name: f.candidate for f in plan.functions
                            if f.candidate is not None}
@@ -49,7 +52,7 @@ class Learner:
         if plan.controller is not None:
             c = plan.controller
             self.controller = Network(len(self.states), c.layers, c.zero_at_origin,
-                                      outputs=len(c.inputs))
+                                      outputs=len(c.inputs), centre=centre)
         self.conditions = {c.name: c for c in plan.conditions}
         self.digits = plan.options.digits  # of the last rounding
         needed = set().union(*(placeholders(c) for c in plan.conditions))
@@ -65,9 +68,7 @@ class Learner:
         """New initial weights for every network, and a new optimiser; the samples (with
         every counterexample so far) are kept."""
         for module in self.modules():
-            for layer in module.modules():
-                if isinstance(layer, torch.nn.Linear):
-                    layer.reset_parameters()
+            module.reset()
         self.optimiser = torch.optim.Adam(self.parameters, lr=self.plan.options.learning_rate)
         self.digits = self.plan.options.digits
 
@@ -389,6 +390,13 @@ def _clip_gradients(parameters, limit: float) -> None:
         for p in parameters:
             if p.grad is not None:
                 p.grad.mul_(limit / norm)
+
+
+def _box_centre(box) -> list[float] | None:
+    if box is None:
+        return None
+    centre = [(low + high) / 2 for low, high in zip(*box)]
+    return centre if all(map(math.isfinite, centre)) else None
 
 
 def _box_scale(box) -> float:

@@ -14,10 +14,14 @@ from fossil_dsl.ir.spec import Layer
 class Network(torch.nn.Module):
     """Hidden layers as given, then a linear output (one value, or `outputs` values for a
     controller). With `zero_at_origin`, there are no biases and the value at 0 is
-    subtracted, so C(0) = 0 exactly, for any activation."""
+    subtracted, so C(0) = 0 exactly, for any activation.
+
+    With a `centre` (the middle of the domain), the first layer's biases start so that
+    it sees x - centre: torch's initial weights suit inputs around 0, and on a domain
+    such as [18, 23]^2 the first steps would otherwise only undo the offset."""
 
     def __init__(self, inputs: int, layers: Sequence[Layer], zero_at_origin: bool,
-                 outputs: int = 1):
+                 outputs: int = 1, centre: Sequence[float] | None = None):
         super().__init__()
         self.activations = [ACTIVATIONS[layer.activation] for layer in layers]
         widths = [inputs] + [layer.width for layer in layers]
@@ -30,6 +34,22 @@ class Network(torch.nn.Module):
         self.zero_at_origin = zero_at_origin
         self.subtract_origin = zero_at_origin and not all(a.zero_at_zero
                                                          for a in self.activations)
+        self.centre = torch.tensor(centre, dtype=torch.float64) \
+            if centre is not None and any(centre) else None
+        self._centre_first_layer()
+
+    def reset(self) -> None:
+        """New initial weights (centred as at construction)."""
+        for layer in [*self.linears, self.output]:
+            layer.reset_parameters()
+        self._centre_first_layer()
+
+    def _centre_first_layer(self) -> None:
+        first = self.linears[0] if len(self.linears) else self.output
+        if self.centre is None or first.bias is None:
+            return
+        with torch.no_grad():
+            first.bias.sub_(first.weight @ self.centre)
 
     def raw(self, x: torch.Tensor) -> torch.Tensor:
         for linear, activation in zip(self.linears, self.activations):
