@@ -76,7 +76,7 @@ class Plan:
     # conditions that exclude the origin exclude the ball of this radius (a delta-decision
     # verifier cannot refute a closed set that touches the origin, where V = dV = 0)
     origin_radius: Fraction = Fraction(0)
-    fallback: str | None = None  # asked where the verifier gives up (UNKNOWN)
+    fallback: str | None = None  # run alongside the verifier where it does not answer at once
 
     @property
     def states(self) -> tuple[str, ...]:
@@ -110,7 +110,7 @@ def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None
     radius = ORIGIN_RADIUS if registry.BACKENDS[verifier].delta_decision else Fraction(0)
     fallback = None if requested or spec.synthesis.verifier else _fallback(verifier)
     if fallback:
-        reason += f"; where it gives up, {fallback}"
+        reason += f"; where it does not answer at once, {fallback} alongside"
     return Plan(spec, rule, functions, conditions, tuple(rule.levels()), controller,
                 verifier, reason, MappingProxyType(samples), options, radius, fallback)
 

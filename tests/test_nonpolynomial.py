@@ -2,6 +2,7 @@
 procedure on codac), CVC5 on transcendental queries, dReal where it is installed."""
 import subprocess
 import sys
+from fractions import Fraction
 from pathlib import Path
 
 import pytest
@@ -14,6 +15,7 @@ from fossil_dsl.smt import registry
 from fossil_dsl.smt.api import Status
 from fossil_dsl.smt.cvc5_backend import Cvc5Backend
 from fossil_dsl.smt.interval_backend import IntervalBackend
+from fossil_dsl.smt.z3_backend import Z3Backend
 from fossil_dsl.smt.smtlib import query_text
 from fossil_dsl.smt.smtlib_reader import read_script
 
@@ -176,8 +178,22 @@ class Scripted:
     def __init__(self, name, answer):
         self.name, self.answer, self.calls = name, answer, []
 
-    def check(self, formula, variables, timeout):
+    def check(self, formula, variables, timeout, stop=None):
         self.calls.append(timeout)
+        return self.answer
+
+
+class Slow:
+    """Answers after `seconds` unless stopped first (then UNKNOWN), like a real solver."""
+    def __init__(self, name, answer, seconds):
+        self.name, self.answer, self.seconds = name, answer, seconds
+        self.stopped = False
+
+    def check(self, formula, variables, timeout, stop=None):
+        from fossil_dsl.smt.api import Answer
+        if stop is not None and stop.wait(min(self.seconds, timeout)):
+            self.stopped = True
+            return Answer(Status.UNKNOWN, reason="stopped")
         return self.answer
 
 
@@ -188,7 +204,7 @@ def test_fallback_asks_the_second_solver_only_where_the_first_gives_up():
     first, second = Scripted("z3", unknown), Scripted("interval", Answer(Status.UNSAT))
     answer = FallbackBackend(first, second).check(L.TRUE, ["x0"], 60)
     assert answer.status is Status.UNSAT and answer.solver == "interval"
-    assert first.calls == [6] and second.calls == [54]
+    assert first.calls == [60] and 59 < second.calls[0] <= 60
     decided = Scripted("z3", Answer(Status.SAT, {"x0": 0}))
     later = Scripted("interval", Answer(Status.UNSAT))
     assert FallbackBackend(decided, later).check(L.TRUE, ["x0"], 60).solver == "z3"
@@ -196,6 +212,58 @@ def test_fallback_asks_the_second_solver_only_where_the_first_gives_up():
     both = FallbackBackend(Scripted("z3", unknown), Scripted("interval", unknown))
     answer = both.check(L.TRUE, ["x0"], 60)
     assert answer.status is Status.UNKNOWN and "z3: timeout; interval: timeout" in answer.reason
+
+
+def test_fallback_runs_both_solvers_at_once_and_the_first_answer_stops_the_other():
+    import time
+    from fossil_dsl.smt import fallback
+    from fossil_dsl.smt.api import Answer
+    slow = Slow("z3", Answer(Status.UNSAT), seconds=30)
+    fast = Slow("interval", Answer(Status.SAT, {"x0": 1}), seconds=fallback.HEAD_START)
+    started = time.monotonic()
+    answer = fallback.FallbackBackend(slow, fast).check(L.TRUE, ["x0"], 60)
+    assert answer.status is Status.SAT and answer.solver == "interval"
+    assert slow.stopped and time.monotonic() - started < 5
+    quick = Slow("z3", Answer(Status.UNSAT), seconds=0.01)
+    never = Slow("interval", Answer(Status.SAT, {"x0": 1}), seconds=0)
+    answer = fallback.FallbackBackend(quick, never).check(L.TRUE, ["x0"], 60)
+    assert answer.solver == "z3"  # answered within its head start: the second never ran
+
+
+def test_z3_stops_when_asked_from_another_thread():
+    import random
+    import threading
+    import time
+    from fractions import Fraction
+    random.seed(1)
+    xs = [E.Var(f"x{i}") for i in range(4)]
+    # a dense degree-5 polynomial in 4 variables over a box: Z3 is still at it after 20 s
+    poly = E.add(*(E.mul(E.Num(Fraction(random.randint(-9, 9), 7)), a, a, b, b, c)
+                   for a in xs for b in xs for c in xs))
+    box = [L.Compare("<=", E.Num(-1), a) for a in xs] + [L.Compare("<=", a, E.ONE) for a in xs]
+    hard = L.conjunction(L.Compare(">", poly, E.Num(45)), *box)
+    stop = threading.Event()
+    threading.Timer(0.3, stop.set).start()
+    started = time.monotonic()
+    answer = Z3Backend().check(hard, [x.name for x in xs], 30, stop)
+    assert answer.status is Status.UNKNOWN and time.monotonic() - started < 3
+
+
+def test_interval_search_stops_when_asked():
+    import threading
+    x, y = E.Var("x0"), E.Var("x1")
+    radius = E.add(E.mul(x, x), E.mul(y, y))
+    # on the circle r^2 = 2, sin(x) + xy just reaches 1.8414710 at (1, 1): many boxes
+    query = L.conjunction(L.Compare("<=", radius, E.Num(2)), L.Compare(">=", radius, E.Num(2)),
+                          L.Compare(">", E.add(E.apply("sin", x), E.mul(x, y)),
+                                    E.Num(Fraction(18414710, 10000000))),
+                          *(L.Compare(op, a, b) for v in (x, y)
+                            for op, a, b in (("<=", E.Num(-3), v), ("<=", v, E.Num(3)))))
+    assert IntervalBackend().check(query, ["x0", "x1"], 30).status is Status.SAT
+    stop = threading.Event()
+    stop.set()
+    answer = IntervalBackend().check(query, ["x0", "x1"], 30, stop)
+    assert answer.status is Status.UNKNOWN and "stopped" in answer.reason
 
 
 def test_fallback_only_when_no_verifier_is_named():

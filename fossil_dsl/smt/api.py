@@ -2,6 +2,7 @@
 model when SAT, and honest UNKNOWN (with its reason) otherwise."""
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from enum import Enum
 from fractions import Fraction
@@ -35,6 +36,9 @@ class UnsupportedTheory(FslError):
 class Backend(Protocol):
     name: str
 
-    def check(self, formula: Formula, variables: Sequence[str], timeout: float) -> Answer:
-        """Is `formula` satisfiable over the reals? `variables` are reported in the model."""
+    def check(self, formula: Formula, variables: Sequence[str], timeout: float,
+              stop: threading.Event | None = None) -> Answer:
+        """Is `formula` satisfiable over the reals? `variables` are reported in the model.
+        Once `stop` is set (from another thread), the backend should give up soon, with
+        UNKNOWN: another solver has answered."""
         ...

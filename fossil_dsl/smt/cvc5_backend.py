@@ -16,7 +16,10 @@ from fossil_dsl.smt.smtlib import query_text
 class Cvc5Backend:
     name = "cvc5"
 
-    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop=None) -> Answer:
+        """`stop` is not looked at: CVC5's API cannot be interrupted, so a query ends
+        at its own time limit."""
         missing = _functions(formula) & NOT_IN_CVC5
         if missing:
             return Answer(Status.UNKNOWN, reason="CVC5 has no " + ", ".join(sorted(missing)))

@@ -8,6 +8,7 @@ in a child process, so that a timeout can end it (the API has no interrupt).
 from __future__ import annotations
 
 import multiprocessing
+import time
 from fractions import Fraction
 from typing import Sequence
 
@@ -24,7 +25,8 @@ class DrealBackend:
     def __init__(self, delta: float = DELTA):
         self.delta = delta
 
-    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop=None) -> Answer:
         names = sorted(set(variables) | L.free_vars(formula))
         receiver, sender = multiprocessing.Pipe(duplex=False)
         worker = multiprocessing.Process(target=_solve_in_child,
@@ -32,8 +34,9 @@ class DrealBackend:
         worker.start()
         sender.close()
         try:
-            if not receiver.poll(timeout):
-                return Answer(Status.UNKNOWN, reason=f"dReal timed out after {timeout:g} s")
+            if not _wait(receiver, timeout, stop):
+                return Answer(Status.UNKNOWN, reason=f"dReal stopped or timed out "
+                              f"(after at most {timeout:g} s)")
             status, model, reason = receiver.recv()
         except EOFError:
             return Answer(Status.UNKNOWN, reason="dReal stopped without an answer")
@@ -107,3 +110,14 @@ class _Translator:
         if isinstance(expr, E.Apply) and hasattr(dreal, expr.func):
             return getattr(dreal, expr.func)(self.expr(expr.arg))
         raise UnsupportedTheory(f"dReal cannot express {expr!r}")
+
+
+def _wait(receiver, timeout: float, stop) -> bool:
+    """Whether an answer arrived within `timeout`, unless `stop` was set first."""
+    end = time.monotonic() + timeout
+    while (left := end - time.monotonic()) > 0:
+        if receiver.poll(min(left, 0.05)):
+            return True
+        if stop is not None and stop.is_set():
+            return False
+    return False

@@ -1,16 +1,22 @@
-"""A complete solver first, and a delta-decision verifier where it gives up.
+"""A complete solver first, and a delta-decision verifier alongside it where the first
+does not answer at once.
 
 Z3 decides polynomial arithmetic completely, but on hard nonlinear queries (a degree-4
-decrease condition in 3 states, say) it can run out of time. The interval verifier then
-often refutes the same query in seconds: its UNSAT is a proof as well, and its delta-SAT
-a counterexample to learn from. Each answer names the solver that gave it.
+decrease condition in 3 states, say) it can run for a long time. The interval verifier
+often refutes the same query in a fraction of a second: its UNSAT is a proof as well, and
+its delta-SAT a counterexample to learn from. So the first solver runs alone for
+HEAD_START seconds (most of its answers come sooner); then the second starts on the same
+query in this thread while the first goes on in its own, and the first definite answer
+(SAT or UNSAT) wins and stops the other. Each answer names the solver that gave it.
 
 CEGIS asks the same condition again after each learning step, with new weights. Once the
-first solver has given up on a query of some form and the second has decided it, later
-queries of that form (the same formula with other numbers) go to the second solver first.
+second solver has won on a query of some form, later queries of that form (the same
+formula with other numbers) give it the head start instead.
 """
 from __future__ import annotations
 
+import threading
+import time
 from dataclasses import replace
 from typing import Sequence
 
@@ -18,7 +24,7 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.smt.api import Answer, Backend, Status
 
-FIRST_SHARE = 0.1  # of the query's time budget that the first solver gets
+HEAD_START = 0.5  # s the leading solver runs alone before the other joins it
 
 
 class FallbackBackend:
@@ -27,29 +33,76 @@ class FallbackBackend:
         self.name = f"{first.name}, then {second.name}"
         self.second_decides: set[tuple] = set()
 
-    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop: threading.Event | None = None) -> Answer:
         form = _form(formula)
-        if form in self.second_decides:
-            answer = self._ask(self.second, formula, variables, timeout * (1 - FIRST_SHARE))
-            if answer.status is not Status.UNKNOWN:
-                return answer
+        order = (self.second, self.first) if form in self.second_decides \
+            else (self.first, self.second)
+        answer, winner = _race(*order, formula, variables, timeout, stop)
+        if winner is self.second:
+            self.second_decides.add(form)
+        elif winner is self.first:
             self.second_decides.discard(form)
-            return self._ask(self.first, formula, variables, timeout * FIRST_SHARE)
-        answer = self._ask(self.first, formula, variables, timeout * FIRST_SHARE)
-        if answer.status is not Status.UNKNOWN:
-            return answer
-        second = self._ask(self.second, formula, variables, timeout * (1 - FIRST_SHARE))
-        if second.status is Status.UNKNOWN:
-            return Answer(Status.UNKNOWN, reason=f"{self.first.name}: {answer.reason}; "
-                          f"{self.second.name}: {second.reason}")
-        self.second_decides.add(form)
-        return replace(second, reason=f"{self.first.name} gave up ({answer.reason}); "
-                       f"{second.reason or 'decided'} by {self.second.name}")
+        return answer
 
-    @staticmethod
-    def _ask(backend: Backend, formula: L.Formula, variables, timeout: float) -> Answer:
-        answer = backend.check(formula, variables, timeout)
-        return replace(answer, solver=answer.solver or backend.name)
+
+def _race(leader: Backend, follower: Backend, formula, variables, timeout: float,
+          stop: threading.Event | None) -> tuple[Answer, Backend | None]:
+    """The first definite answer of the two solvers, and which gave it (None if neither
+    did). The leader runs alone for HEAD_START seconds, then both run."""
+    started = time.monotonic()
+    finished = threading.Event()  # set when one solver has answered for good
+    answers: dict[str, Answer] = {}
+
+    def lead():
+        answers["leader"] = _ask(leader, formula, variables, timeout, finished)
+        if answers["leader"].status is not Status.UNKNOWN:
+            finished.set()
+
+    thread = threading.Thread(target=lead, daemon=True)
+    thread.start()
+    relay = _relay(stop, finished) if stop is not None else None
+    thread.join(min(HEAD_START, timeout))
+    if not finished.is_set():
+        left = max(0.0, timeout - (time.monotonic() - started))
+        answers["follower"] = _ask(follower, formula, variables, left, finished)
+        if answers["follower"].status is not Status.UNKNOWN:
+            finished.set()
+    thread.join()
+    finished.set()  # ends the relay
+    if relay is not None:
+        relay.join()
+    return _outcome(leader, follower, answers)
+
+
+def _relay(stop: threading.Event, finished: threading.Event) -> threading.Thread:
+    """Passes a stop from outside on to both solvers."""
+    def watch():
+        while not finished.wait(0.05):
+            if stop.is_set():
+                finished.set()
+    thread = threading.Thread(target=watch, daemon=True)
+    thread.start()
+    return thread
+
+
+def _outcome(leader, follower, answers) -> tuple[Answer, Backend | None]:
+    lead, follow = answers["leader"], answers.get("follower")
+    if lead.status is not Status.UNKNOWN:
+        return lead, leader
+    if follow is not None and follow.status is not Status.UNKNOWN:
+        return replace(follow, reason=f"{leader.name} had not answered "
+                       f"({lead.reason}); {follow.reason or 'decided'} by {follower.name}"), \
+            follower
+    reasons = [f"{leader.name}: {lead.reason}"]
+    if follow is not None:
+        reasons.append(f"{follower.name}: {follow.reason}")
+    return Answer(Status.UNKNOWN, reason="; ".join(reasons)), None
+
+
+def _ask(backend: Backend, formula, variables, timeout: float, stop) -> Answer:
+    answer = backend.check(formula, variables, timeout, stop)
+    return replace(answer, solver=answer.solver or backend.name)
 
 
 def _form(formula: L.Formula) -> tuple:

@@ -16,6 +16,7 @@ boxes of a depth-first search are contracted and bisected:
 """
 from __future__ import annotations
 
+import threading
 import time
 from collections import Counter
 from fractions import Fraction
@@ -36,7 +37,8 @@ class IntervalBackend:
     def __init__(self, delta: float = DELTA):
         self.delta = delta
 
-    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop: threading.Event | None = None) -> Answer:
         names = sorted(set(variables) | L.free_vars(formula))
         deadline = time.monotonic() + timeout
         with upward_rounding() as codac:
@@ -48,9 +50,9 @@ class IntervalBackend:
                 return _unbounded() if names else Answer(Status.SAT, {})
             start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
             split = _worth_splitting(formula, names)
-            return self._search(contractor, start, names, split, variables, deadline)
+            return self._search(contractor, start, names, split, variables, deadline, stop)
 
-    def _search(self, contractor, start, names, split, variables, deadline) -> Answer:
+    def _search(self, contractor, start, names, split, variables, deadline, stop) -> Answer:
         contractor.contract(start)
         if start.is_empty():
             return Answer(Status.UNSAT)
@@ -74,6 +76,8 @@ class IntervalBackend:
                 # its middle is refuted: look on for a better witness, keep this one
                 unresolved = unresolved or box
                 continue
+            if boxes % 64 == 0 and stop is not None and stop.is_set():
+                return Answer(Status.UNKNOWN, reason=f"stopped after {boxes} boxes")
             if boxes % 256 == 0 and time.monotonic() > deadline:
                 if unresolved is not None:
                     return _delta_sat(unresolved, names, variables, self.delta)

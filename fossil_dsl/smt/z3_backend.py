@@ -6,6 +6,7 @@ sound enclosure; the answer then carries `approximate=True`.
 from __future__ import annotations
 
 import threading
+import time
 from fractions import Fraction
 from typing import Sequence
 
@@ -15,6 +16,8 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import bounds
 from fossil_dsl.smt.api import Answer, Status, UnsupportedTheory
+
+STOP_POLL = 0.02  # s between looks at whether to interrupt Z3
 
 
 class Z3Converter:
@@ -98,7 +101,8 @@ class Z3Backend:
     def check_text(self, text: str, timeout: float, variables=()) -> Answer:
         return check_smtlib(text, timeout)
 
-    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float) -> Answer:
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop: threading.Event | None = None) -> Answer:
         context = z3.Context()
         converter = Z3Converter(context)
         try:
@@ -109,7 +113,7 @@ class Z3Backend:
         solver.set("timeout", max(1, int(timeout * 1000)))
         solver.add(term, *converter.side_conditions)
         approximate = bool(converter.side_conditions)
-        result = _check_with_deadline(solver, context, timeout)
+        result = _check_with_deadline(solver, context, timeout, stop)
         if result == z3.unsat:
             return Answer(Status.UNSAT, approximate=approximate)
         if result == z3.sat:
@@ -138,16 +142,29 @@ def check_smtlib(text: str, timeout: float) -> Answer:
     return Answer(Status.UNKNOWN, reason=solver.reason_unknown())
 
 
-def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float):
-    """solver.check(), interrupted from a timer if Z3 overruns its own timeout (nlsat does
-    not always look at the clock, e.g. on high-degree polynomials)."""
-    timer = threading.Timer(timeout + 1.0, context.interrupt)
-    timer.daemon = True
-    timer.start()
+def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
+                         stop: threading.Event | None = None):
+    """solver.check(), interrupted from a watcher thread once `stop` is set, or if Z3
+    overruns its own timeout (nlsat does not always look at the clock, e.g. on
+    high-degree polynomials)."""
+    done, lock = threading.Event(), threading.Lock()
+    end = time.monotonic() + timeout + 1.0
+
+    def watch():
+        while not done.wait(STOP_POLL):
+            if (stop is not None and stop.is_set()) or time.monotonic() > end:
+                with lock:  # never interrupt a context whose check has returned
+                    if not done.is_set():
+                        context.interrupt()
+                return
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
     try:
         return solver.check()
     finally:
-        timer.cancel()
+        with lock:
+            done.set()
 
 
 def _to_fraction(value) -> Fraction:
