@@ -107,7 +107,7 @@ class ScriptedBackend:
     def __init__(self, status):
         self.status = status
 
-    def check(self, formula, variables, timeout):
+    def check(self, formula, variables, timeout, stop=None):
         model = {v: 0 for v in variables} if self.status is Status.SAT else None
         return Answer(self.status, model, reason="scripted")
 

@@ -299,3 +299,14 @@ def test_fallback_goes_to_the_second_solver_first_for_a_form_it_decided():
     second.answer = Answer(Status.UNKNOWN, reason="timeout")  # now the second gives up
     assert backend.check(query(4), ["x0"], 60).status is Status.UNKNOWN
     assert len(first.calls) == 3  # the first solver was asked again
+
+
+def test_interval_compiler_shares_equal_subexpressions():
+    from fossil_dsl.ir.enclosure import upward_rounding
+    from fossil_dsl.smt.interval_backend import _Compiler
+    x, y = E.Var("x0"), E.Var("x1")
+    neuron = lambda: E.apply("tanh", E.add(E.mul(E.Num(2), x), y))
+    with upward_rounding() as codac:
+        compiler = _Compiler(codac, ["x0", "x1"])
+        assert compiler.expr(neuron()) is compiler.expr(neuron())
+        assert compiler.expr(E.mul(neuron(), x)) is not compiler.expr(neuron())

@@ -147,6 +147,10 @@ class _Compiler:
         self.codac = codac
         self.vector = codac.VectorVar(len(names))
         self.index = {name: i for i, name in enumerate(names)}
+        # equal subexpressions become one codac node: a network's neurons recur in its
+        # derivative, and codac then evaluates them once per box and intersects what
+        # each occurrence says about them when contracting
+        self.shared: dict[E.Expr, object] = {}
 
     def formula(self, formula: L.Formula):
         """A contractor for the closure of the formula's set; None for TRUE."""
@@ -184,6 +188,12 @@ class _Compiler:
         return self.codac.CtcEmpty(len(self.index)) if false else None
 
     def expr(self, expr: E.Expr):
+        translated = self.shared.get(expr)
+        if translated is None:
+            translated = self.shared[expr] = self._translate(expr)
+        return translated
+
+    def _translate(self, expr: E.Expr):
         codac = self.codac
         if isinstance(expr, E.Num):
             return rational_interval(expr.value)
