@@ -230,6 +230,21 @@ def test_fallback_runs_both_solvers_at_once_and_the_first_answer_stops_the_other
     assert answer.solver == "z3"  # answered within its head start: the second never ran
 
 
+def test_fallback_passes_a_stop_from_outside_on_to_both_solvers():
+    import threading
+    import time
+    from fossil_dsl.smt.fallback import FallbackBackend
+    from fossil_dsl.smt.api import Answer
+    first = Slow("z3", Answer(Status.UNSAT), seconds=30)
+    second = Slow("interval", Answer(Status.UNSAT), seconds=30)
+    stop = threading.Event()
+    threading.Timer(1.0, stop.set).start()
+    started = time.monotonic()
+    answer = FallbackBackend(first, second).check(L.TRUE, ["x0"], 60, stop)
+    assert answer.status is Status.UNKNOWN and first.stopped and second.stopped
+    assert time.monotonic() - started < 5
+
+
 def test_z3_stops_when_asked_from_another_thread():
     import random
     import threading

@@ -62,6 +62,8 @@ class IntervalBackend:
         while stack:
             box = stack.pop()
             boxes += 1
+            if boxes % 64 == 0 and stop is not None and stop.is_set():
+                return Answer(Status.UNKNOWN, reason=f"stopped after {boxes} boxes")
             since += unresolved is not None
             if since > WITNESS_SEARCH:
                 return _delta_sat(unresolved, names, variables, self.delta)
@@ -76,8 +78,6 @@ class IntervalBackend:
                 # its middle is refuted: look on for a better witness, keep this one
                 unresolved = unresolved or box
                 continue
-            if boxes % 64 == 0 and stop is not None and stop.is_set():
-                return Answer(Status.UNKNOWN, reason=f"stopped after {boxes} boxes")
             if boxes % 256 == 0 and time.monotonic() > deadline:
                 if unresolved is not None:
                     return _delta_sat(unresolved, names, variables, self.delta)
