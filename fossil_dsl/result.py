@@ -15,7 +15,6 @@ from fossil_dsl.version import __version__
 from fossil_dsl.cegis.loop import CegisOutcome
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir.symbolic import to_sympy
-from fossil_dsl.learn.networks import rational
 from fossil_dsl.plan import Plan
 from fossil_dsl.plot import phase_portrait
 from fossil_dsl.smt import registry
@@ -148,20 +147,17 @@ class Result:
 
 def network_json(network, digits: int) -> dict:
     """A network's layers with every weight and bias as an exact rational ("p/q"): the
-    values that the formulas above were built from."""
-    layers = [{"activation": act.name, **_affine_json(linear, digits)}
-              for linear, act in zip(network.linears, network.activations)]
-    layers.append({"activation": "identity", **_affine_json(network.output, digits)})
-    return {"inputs": network.linears[0].in_features if len(network.linears)
-            else network.output.in_features, "outputs": network.outputs,
+    values that the formulas above were built from (weights on x itself, so a first
+    layer that sees x / input_divisor is given with its weights divided)."""
+    linears = [*network.linears, network.output]
+    activations = [act.name for act in network.activations] + ["identity"]
+    layers = [{"activation": activation,
+               "weight": [[str(w) for w in row] for row in weights],
+               "bias": None if linear.bias is None else [str(b) for b in biases]}
+              for linear, activation, (weights, biases)
+              in zip(linears, activations, network.exact_layers(digits))]
+    return {"inputs": linears[0].in_features, "outputs": network.outputs,
             "subtracts_value_at_origin": network.subtract_origin, "layers": layers}
-
-
-def _affine_json(linear, digits: int) -> dict:
-    weights = [[str(rational(w, digits)) for w in row] for row in linear.weight.tolist()]
-    biases = None if linear.bias is None else \
-        [str(rational(b, digits)) for b in linear.bias.tolist()]
-    return {"weight": weights, "bias": biases}
 
 
 def versions() -> dict[str, str | None]:

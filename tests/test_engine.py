@@ -280,3 +280,18 @@ def test_restart_draws_new_weights_and_keeps_the_samples():
     assert all(not torch.equal(a, b) for a, b in zip(before, learner.parameters))
     assert all(torch.equal(samples[k], learner.samples[k]) for k in samples)
     assert learner.optimiser.param_groups[0]["params"] == learner.parameters
+
+
+def test_a_stiff_field_component_gives_the_certificate_a_scaled_input():
+    """Over hi_ord_8's training samples, its last field component is about 12000 times
+    the others: the barrier sees x7 / 10^4. A controlled system is judged open loop;
+    row 7's fields (1.6 and 0 with u = 0) need no scaling."""
+    from fossil_dsl.cegis.learner import Learner
+    root = Path(__file__).resolve().parent.parent / "specs"
+    expected = {"scaling/hi_ord_08.fsl": (1,) * 7 + (10 ** 4,),
+                "scaling/hi_ord_04.fsl": None,
+                "benchmarks/row07_swa_ctrl_second_order.fsl": None}
+    for name, divisors in expected.items():
+        plan = compile_spec(fossil_dsl.load(root / name))
+        learner = Learner(plan, torch.Generator().manual_seed(0))
+        assert {n.divisors for n in learner.networks.values()} == {divisors}, name

@@ -1,5 +1,7 @@
 """The exact formula that is verified is the function the learner trained: for every
 activation, formula(x) equals the torch network at random points."""
+from fractions import Fraction
+
 import pytest
 import torch
 
@@ -7,7 +9,7 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir.activations import ACTIVATIONS
 from fossil_dsl.ir.spec import Layer
 from fossil_dsl.learn.evaluate import evaluate, state_env
-from fossil_dsl.learn.networks import Network
+from fossil_dsl.learn.networks import Network, input_divisors
 
 STATES = ("x0", "x1", "x2")
 
@@ -61,3 +63,46 @@ def test_centring_leaves_networks_on_domains_around_the_origin_and_without_biase
     assert all(torch.equal(a, b) for a, b in zip(plain.parameters(), centred.parameters()))
     no_bias = Network(2, [Layer("square", 3)], zero_at_origin=True, centre=[20.0, 20.0])
     assert no_bias(torch.zeros(1, 2, dtype=torch.float64)).item() == 0.0
+
+
+def test_input_divisor_is_exact_in_the_formula_and_the_weights_on_x():
+    torch.manual_seed(11)
+    network = Network(3, [Layer("linear", 4), Layer("square", 2)], zero_at_origin=False,
+                      centre=[1.0, 0.0, 0.0], input_divisor=(1, 1000, 1))
+    network.round_weights(3)
+    points = torch.rand(40, 3, dtype=torch.float64) * 4 - 2
+    exact = evaluate(network.formula(STATES, 3), state_env(STATES, points))
+    assert torch.allclose(torch.as_tensor(exact, dtype=torch.float64), network(points),
+                          rtol=1e-12, atol=1e-12)
+    weights, _ = network.exact_layers(3)[0]
+    trained = network.linears[0].weight.detach()
+    assert weights[0][1] == Fraction(round(float(trained[0, 1]) * 1000), 1000) / 1000
+    assert weights[0][0] == Fraction(round(float(trained[0, 0]) * 1000), 1000)
+    assert "input_divisor" in network.state_dict()
+    from fossil_dsl.result import network_json
+    reported = network_json(network, 3)["layers"][0]["weight"]
+    assert reported == [[str(w) for w in row] for row in weights]
+
+
+def test_no_divisor_when_every_field_component_is_of_one_size():
+    assert input_divisors([1.3, 2.9, 0.2]) is None
+    assert input_divisors([0.0, 0.0, 5.0]) is None  # median 0: no scale to compare with
+    assert input_divisors([1.25, 1.27, 1.27, 8390.0]) == (1, 1, 1, 1000)
+    assert input_divisors([1.0, 1.0, 99.0]) is None
+    assert input_divisors([1.0, 1.0, 1.0, 150.0, 2.5e7]) == (1, 1, 1, 100, 10 ** 7)
+
+
+def test_climb_moves_along_a_level_set_to_the_worst_point_in_the_box():
+    from fossil_dsl.learn.ascent import climb
+
+    def objective(x):  # violation x1, on the level set x0 + x1 = 1
+        return x[:, 1], x[:, 0] + x[:, 1] - 1
+
+    starts = torch.tensor([[0.5, 0.5], [1.5, -0.5], [0.0, 1.0]], dtype=torch.float64)
+    moved = climb(starts, objective, ([-2.0, -2.0], [2.0, 2.0]), steps=30, step_fraction=0.02)
+    assert torch.allclose(moved[:, 0] + moved[:, 1], torch.ones(3, dtype=torch.float64),
+                          atol=1e-9)
+    assert (moved[:, 1] > 1.9 - 1e-9).all() and (moved.abs() <= 2.0).all()
+    free = climb(starts, lambda x: (-x.pow(2).sum(1), None), ([-2.0, -2.0], [2.0, 2.0]),
+                 steps=30, step_fraction=0.02)
+    assert free.abs().max() < 0.1  # no level set: plain ascent, to the origin here

@@ -12,11 +12,13 @@ import time
 
 import torch
 
-from fossil_dsl.certificates.base import Condition, Level, change_of, level_of, value_of
+from fossil_dsl.certificates.base import (Condition, Level, change_of, level_of,
+                                          level_set_parts, value_of)
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.learn.ascent import climb
 from fossil_dsl.learn.evaluate import evaluate, holds, state_env
-from fossil_dsl.learn.networks import Network
+from fossil_dsl.learn.networks import Network, input_divisors
 from fossil_dsl.learn.sampling import around, sample
 from fossil_dsl.plan import Plan
 
@@ -25,6 +27,13 @@ EXTRA_DIGITS = 3  # decimals that rounding may add to the plan's when 3 undo the
 FRESH_FACTOR = 4  # fresh samples drawn to look for violations, per training sample
 FRESH_KEPT = 50  # violating fresh samples added per condition and search, the worst first
 FRESH_SEARCHES = 5  # searches of fresh samples per training round, at most
+# A guard such as B(x) = 0 holds on no random sample, so fresh samples cannot show a
+# violation of its condition: the worst of them in the band are moved along the level
+# set, uphill on the violation, and kept where they violate within LEVEL_BAND of it.
+CLIMB_POINTS = 200
+CLIMB_STEPS = 30
+CLIMB_STEP = 0.02  # of the box's width, per step and coordinate
+LEVEL_BAND = 0.01  # relative, as GUARD_BAND
 LOCAL_SEARCH = 2000  # points drawn near a counterexample to find the violations near it
 # Adam's second-moment decay. torch's 0.999 remembers the large gradients of early
 # training for about 1000 steps; late in training, when a few samples still violate a
@@ -47,9 +56,11 @@ class Learner:
         self.states = plan.states
         self.generator = generator
         self.box = plan.spec.domain.bounding_box()
+        self.samples = self.initial_samples()
         centre = _box_centre(self.box)
+        divisors = input_divisors(self.field_scales(torch.cat(list(self.samples.values()))))
         self.networks = {f.name: Network(len(self.states), f.layers, f.zero_at_origin,
-                                         centre=centre)
+                                         centre=centre, input_divisor=divisors)
                          for f in plan.functions if f.candidate is None}
         self.candidates = {f.name: f.candidate for f in plan.functions
                            if f.candidate is not None}
@@ -62,7 +73,6 @@ class Learner:
         self.digits = plan.options.digits  # of the last rounding
         needed = set().union(*(placeholders(c) for c in plan.conditions))
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
-        self.samples = self.initial_samples()
         self.control_samples = sample(plan.spec.domain, self.states, 500, generator, self.box) \
             if self.controller is not None else None
         self.parameters = [p for m in self.modules() for p in m.parameters()]
@@ -107,13 +117,13 @@ class Learner:
         scale = _box_scale(self.box)
         extra = around(centre, condition.region, self.states,
                        self.plan.options.counterexample_neighbours, 0.02 * scale,
-                       self.generator)
+                       self.generator, self.box)
         if len(extra) == 1:  # a set of measure zero (a boundary): weigh the point itself
             extra = extra.repeat(5, 1)
         self.samples[name] = torch.cat([self.samples[name], extra])
         # a counterexample often sits in a thin sliver of violations: look for the rest
         nearby = around(centre, condition.region, self.states, LOCAL_SEARCH, 0.05 * scale,
-                        self.generator)
+                        self.generator, self.box)
         self._keep_violators(condition, nearby, self.levels())
 
     def add_fresh_violators(self) -> bool:
@@ -125,11 +135,35 @@ class Learner:
             count = FRESH_FACTOR * self.plan.samples[condition.name]
             points = sample(condition.region, self.states, count, self.generator, self.box)
             found = self._keep_violators(condition, points, levels) or found
+            if level_set_parts(condition.guard) is not None:
+                found = self._climb_level_set(condition, points, levels) or found
         return found
 
-    def _keep_violators(self, condition: Condition, points: torch.Tensor, levels) -> bool:
+    def _climb_level_set(self, condition: Condition, points: torch.Tensor, levels) -> bool:
+        """Move the worst points in the guard's band along its level set, uphill on the
+        violation, and keep those that end up violating it."""
+        box = condition.region.bounding_box() or self.box
+        if box is None or not len(points):
+            return False
+        env = self.detached_environment(condition, points, levels)
+        violation = torch.as_tensor(violation_of(condition.claim, env)).expand(len(points))
+        band = guard_mask(condition.guard, env, len(points), GUARD_BAND)
+        starts = points[band][violation[band].argsort(descending=True)[:CLIMB_POINTS]]
+        left, right = level_set_parts(condition.guard)
+
+        def objective(x):
+            env = self.environment(condition, x, levels)
+            return violation_of(condition.claim, env), evaluate(left, env) - evaluate(right, env)
+        moved = climb(starts, objective, box, CLIMB_STEPS, CLIMB_STEP)
+        inside = holds(condition.region.contains_formula(self.states),
+                       state_env(self.states, moved), len(moved))
+        return self._keep_violators(condition, moved[inside], levels, LEVEL_BAND)
+
+    def _keep_violators(self, condition: Condition, points: torch.Tensor, levels,
+                        band: float = 0.0) -> bool:
         """Add to the condition's samples the points (the worst FRESH_KEPT) where its
-        guard holds and its claim does not, with no margin. Whether there was one."""
+        guard holds (within `band`, relative) and its claim does not, with no margin.
+        Whether there was one."""
         if condition.exclude_origin:
             points = points[points.norm(dim=1) > 1e-6]
         if not len(points):
@@ -137,7 +171,7 @@ class Learner:
         env = self.detached_environment(condition, points, levels)
         violation = torch.as_tensor(violation_of(condition.claim, env),
                                     dtype=torch.float64).expand(len(points))
-        bad = (violation > 0) & guard_mask(condition.guard, env, len(points), 0.0)
+        bad = (violation > 0) & guard_mask(condition.guard, env, len(points), band)
         if not bad.any():
             return False
         worst = violation[bad].argsort(descending=True)[:FRESH_KEPT]
@@ -157,12 +191,14 @@ class Learner:
         self.samples[name] = torch.cat([self.samples[name], extra])
 
     # ---- values ----
-    def field(self, points: torch.Tensor) -> list[torch.Tensor]:
-        """The closed-loop vector field (or next state) at the points."""
+    def field(self, points: torch.Tensor, open_loop: bool = False) -> list[torch.Tensor]:
+        """The closed-loop vector field (or next state) at the points; open loop: with
+        every input 0."""
         env = state_env(self.states, points)
         inputs = None
-        if self.controller is not None:
-            inputs = self.controller(points)
+        if self.plan.controller is not None:
+            inputs = torch.zeros(len(points), len(self.plan.controller.inputs),
+                                 dtype=torch.float64) if open_loop else self.controller(points)
             inputs = inputs.unsqueeze(1) if inputs.dim() == 1 else inputs
             env.update({u: inputs[:, i] for i, u in enumerate(self.plan.controller.inputs)})
         if self.plan.spec.torch_dynamics is not None:
@@ -170,6 +206,12 @@ class Learner:
             return list(torch.as_tensor(values, dtype=torch.float64).unbind(1))
         return [torch.as_tensor(evaluate(f, env), dtype=torch.float64).expand(len(points))
                 for f in self.plan.spec.dynamics]
+
+    def field_scales(self, points: torch.Tensor) -> list[float]:
+        """The root mean square of each open-loop field component over the points (the
+        training samples: the sizes the loss sees)."""
+        with torch.no_grad():
+            return [float(f.pow(2).mean().sqrt()) for f in self.field(points, open_loop=True)]
 
     def function(self, name: str, points: torch.Tensor) -> torch.Tensor:
         if name in self.networks:

@@ -88,6 +88,17 @@ def level_set(function: str, level: E.Expr = E.ZERO) -> L.Formula:
     return L.conjunction(L.Compare("<=", value, level), L.Compare(">=", value, level))
 
 
+def level_set_parts(guard: L.Formula) -> tuple[E.Expr, E.Expr] | None:
+    """(f, c) where the guard is the level set f = c as `level_set` writes it, else None."""
+    if isinstance(guard, L.And) and len(guard.args) == 2:
+        below, above = guard.args
+        if isinstance(below, L.Compare) and isinstance(above, L.Compare) \
+                and (below.relation, above.relation) == ("<=", ">=") \
+                and (below.left, below.right) == (above.left, above.right):
+            return below.left, below.right
+    return None
+
+
 class Certificate:
     """A certificate rule for one property form.
 

@@ -41,16 +41,30 @@ def sample(region: SetExpr, states: Sequence[str], count: int, generator: torch.
 
 
 def around(points: torch.Tensor, region: SetExpr, states: Sequence[str], count: int,
-           radius: float, generator: torch.Generator) -> torch.Tensor:
-    """The points plus `count` random neighbours of each that lie in `region`."""
+           radius: float, generator: torch.Generator, box=None) -> torch.Tensor:
+    """The points plus `count` random neighbours of each that lie in `region`. A
+    neighbour that leaves the region's box (or `box`) through a face is reflected back
+    through it: at a corner of a box in n dimensions, a 2^-n share of neighbours would
+    otherwise survive, and verifiers often answer with such corners."""
     if count == 0 or len(points) == 0:
         return points
     noise = torch.randn(len(points) * count, points.shape[1], generator=generator,
                         dtype=torch.float64) * radius
     neighbours = points.repeat_interleave(count, 0) + noise
+    box = region.bounding_box() or box
+    if box is not None:
+        neighbours = _reflect_into(neighbours, box)
     keep = holds(region.contains_formula(states), state_env(states, neighbours),
                  len(neighbours))
     return torch.cat([points, neighbours[keep]])
+
+
+def _reflect_into(points: torch.Tensor, box) -> torch.Tensor:
+    low = torch.tensor(box[0], dtype=torch.float64)
+    high = torch.tensor(box[1], dtype=torch.float64)
+    points = torch.where(points < low, 2 * low - points, points)
+    points = torch.where(points > high, 2 * high - points, points)
+    return torch.minimum(torch.maximum(points, low), high)
 
 
 def _boundary(inner: SetExpr, states, count: int, generator, fallback_box) -> torch.Tensor:
