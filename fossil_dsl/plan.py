@@ -47,7 +47,7 @@ class RunOptions:
     query_timeout: float = 60.0  # seconds per verifier query
     learn_steps: int = 1000  # gradient steps per CEGIS iteration at most
     counterexample_neighbours: int = 20
-    control_weight: float = 0.1  # of the control loss (f(x) pointing towards the origin)
+    control_weight: float = 0.1  # of the control loss (f(x) pointing to the goal or origin)
     learn_only: bool = False  # train, measure violations on fresh samples, prove nothing
     delta: float | None = None  # precision of a delta-decision verifier (its default if None)
 
@@ -59,6 +59,8 @@ class ControllerPlan:
     inputs: tuple[str, ...]
     layers: tuple[Layer, ...]
     zero_at_origin: bool  # k(0) = 0, so the closed loop keeps the equilibrium
+    # the set the closed loop is steered towards (the property's goal), else the origin
+    target: S.SetExpr | None = None
 
 
 @dataclass(frozen=True)
@@ -137,7 +139,7 @@ def _controller(spec: CheckedSpec, rule: Certificate) -> ControllerPlan | None:
     if not spec.inputs:
         return None
     layers = spec.synthesis.controller or (Layer("linear", len(spec.inputs)),)
-    return ControllerPlan(spec.inputs, layers, rule.keeps_equilibrium)
+    return ControllerPlan(spec.inputs, layers, rule.keeps_equilibrium, rule.control_target())
 
 
 def _sample_count(spec: CheckedSpec, region: S.SetExpr) -> int:
@@ -265,6 +267,13 @@ def plan_text(plan: Plan, explain: bool = False) -> str:
     return "\n".join(lines)
 
 
+def _control_loss_words(target: S.SetExpr | None) -> str:
+    if target is None:
+        return "cos(x, f(x, k(x))) over samples of the domain (f should point to 0)"
+    return (f"cos(x - c, f(x, k(x))) over samples of the domain and as many near "
+            f"{target.text()} (f should point to c, the centre of its bounding box)")
+
+
 def loss_text(plan: Plan) -> str:
     """The learner's loss terms: one per condition, summed."""
     margin = plan.options.margin
@@ -286,7 +295,7 @@ def loss_text(plan: Plan) -> str:
                      f"over {where}")
     if plan.controller:
         lines.append(f"  [control] {plan.options.control_weight:g} * mean of "
-                     "cos(x, f(x, k(x))) over samples of the domain (f should point to 0)")
+                     + _control_loss_words(plan.controller.target))
     lines.append("  ($V is the network's value, $dV its "
                  + ("one-step difference" if plan.certificate.discrete
                     else "derivative along the flow by automatic differentiation")

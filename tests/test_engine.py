@@ -295,3 +295,47 @@ def test_a_stiff_field_component_gives_the_certificate_a_scaled_input():
         plan = compile_spec(fossil_dsl.load(root / name))
         learner = Learner(plan, torch.Generator().manual_seed(0))
         assert {n.divisors for n in learner.networks.values()} == {divisors}, name
+
+
+STEERED = """
+spec steered
+state x0, x1
+input u0, u1
+dynamics continuous {
+    x0' = u0
+    x1' = u1
+}
+domain box([-2, -2], [2, 2])
+set safe = box([-1.5, -1.5], [1.5, 1.5])
+set init = box([-1, -1], [-0.5, -0.5])
+set goal = box([-0.1, -0.05], [0.3, 0.35])
+prove from init: safe until goal
+"""
+
+
+def test_the_controller_is_steered_towards_the_goal_and_looks_near_it():
+    """With a goal, the control loss rewards a field pointing to the goal's centre, and
+    half its samples lie near the goal (its box scaled by 3): -1 exactly when the field
+    points to the centre everywhere, more when it points to the origin."""
+    from fossil_dsl.cegis.learner import TARGET_SURROUNDINGS, Learner
+    plan = compile_spec(spec_text(STEERED))
+    assert plan.controller.target == plan.spec.property.role("goal")
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    centre = torch.tensor([0.1, 0.15], dtype=torch.float64)
+    assert torch.allclose(learner.control_target, centre)
+    near = learner.control_samples[len(learner.control_samples) // 2:]
+    assert ((near - centre).abs() <= TARGET_SURROUNDINGS * 0.2 + 1e-12).all()
+    learner.field = lambda points: list((centre - points).unbind(1))
+    assert float(learner.control_loss()) == pytest.approx(-1.0)
+    learner.field = lambda points: list((-points).unbind(1))
+    assert float(learner.control_loss()) > -0.97
+
+
+def test_without_a_goal_the_controller_is_steered_to_the_origin():
+    from fossil_dsl.cegis.learner import Learner
+    plan = compile_spec(spec_file("stability_controlled"))
+    assert plan.controller.target is None
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    assert learner.control_target.abs().max() == 0
+    learner.field = lambda points: list((-points).unbind(1))
+    assert float(learner.control_loss()) == pytest.approx(-1.0)

@@ -34,6 +34,8 @@ CLIMB_POINTS = 200
 CLIMB_STEPS = 30
 CLIMB_STEP = 0.02  # of the box's width, per step and coordinate
 LEVEL_BAND = 0.01  # relative, as GUARD_BAND
+CONTROL_SAMPLES = 500  # where the control loss looks, over the domain (and again near a goal)
+TARGET_SURROUNDINGS = 3.0  # the box near a goal: its bounding box scaled by this
 LOCAL_SEARCH = 2000  # points drawn near a counterexample to find the violations near it
 # Adam's second-moment decay. torch's 0.999 remembers the large gradients of early
 # training for about 1000 steps; late in training, when a few samples still violate a
@@ -73,8 +75,8 @@ class Learner:
         self.digits = plan.options.digits  # of the last rounding
         needed = set().union(*(placeholders(c) for c in plan.conditions))
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
-        self.control_samples = sample(plan.spec.domain, self.states, 500, generator, self.box) \
-            if self.controller is not None else None
+        self.control_target, self.control_samples = self.controller_samples() \
+            if self.controller is not None else (None, None)
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
 
@@ -319,12 +321,34 @@ class Learner:
             met = _met(_shortfall(condition, env, margin / 2).detach(), condition.guard, env)
         return shortfall[mask].mean(), met
 
+    def controller_samples(self) -> tuple[torch.Tensor, torch.Tensor]:
+        """The point the controller steers to (the centre of the plan's target set, else
+        the origin) and where its loss looks: the domain, and as many points again near
+        the target, where a closed-loop equilibrium just outside a small goal set would
+        otherwise hide between samples (row 9: the verifier found one there each
+        iteration, and each fix moved it along the curve of equilibria)."""
+        everywhere = sample(self.plan.spec.domain, self.states, CONTROL_SAMPLES,
+                            self.generator, self.box)
+        box = self.plan.controller.target.bounding_box() \
+            if self.plan.controller.target is not None else None
+        if box is None:
+            return torch.zeros(len(self.states), dtype=torch.float64), everywhere
+        low, high = (torch.tensor(side, dtype=torch.float64) for side in box)
+        centre, reach = (low + high) / 2, TARGET_SURROUNDINGS * (high - low) / 2
+        if self.box is not None:
+            low = torch.maximum(centre - reach, torch.tensor(self.box[0], dtype=torch.float64))
+            high = torch.minimum(centre + reach, torch.tensor(self.box[1], dtype=torch.float64))
+        near = low + (high - low) * torch.rand(CONTROL_SAMPLES, len(self.states),
+                                               generator=self.generator, dtype=torch.float64)
+        return centre, torch.cat([everywhere, near])
+
     def control_loss(self) -> torch.Tensor:
-        """Rewards a closed-loop field pointing towards the origin."""
-        points = self.control_samples
-        points = points[points.norm(dim=1) > 1e-6]
-        field = torch.stack(self.field(points), 1)
-        return torch.nn.functional.cosine_similarity(points, field, dim=1, eps=1e-9).mean()
+        """Rewards a closed-loop field pointing towards the target."""
+        offsets = self.control_samples - self.control_target
+        keep = offsets.norm(dim=1) > 1e-6
+        field = torch.stack(self.field(self.control_samples[keep]), 1)
+        return torch.nn.functional.cosine_similarity(offsets[keep], field, dim=1,
+                                                     eps=1e-9).mean()
 
     def train(self, steps: int, deadline: float) -> float:
         loss_value, searches = 0.0, 0

@@ -148,6 +148,11 @@ class Certificate:
     def role(self, name: str) -> SetExpr:
         return self.spec.property.role(name)
 
+    def control_target(self) -> SetExpr | None:
+        """Where a learned controller should steer the state: the property's goal if it
+        has one (None: the origin)."""
+        return self.spec.property.role("goal")
+
     def change_word(self, function: str) -> str:
         return f"{function}(f(x)) - {function}(x)" if self.discrete else f"d{function}/dt"
 
