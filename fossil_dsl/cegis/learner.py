@@ -329,15 +329,16 @@ class Learner:
         iteration, and each fix moved it along the curve of equilibria)."""
         everywhere = sample(self.plan.spec.domain, self.states, CONTROL_SAMPLES,
                             self.generator, self.box)
-        box = self.plan.controller.target.bounding_box() \
-            if self.plan.controller.target is not None else None
-        if box is None:
+        target = self.plan.controller.target
+        box = target.bounding_box() if target is not None else None
+        if _box_centre(box) is None:
             return torch.zeros(len(self.states), dtype=torch.float64), everywhere
         low, high = (torch.tensor(side, dtype=torch.float64) for side in box)
         centre, reach = (low + high) / 2, TARGET_SURROUNDINGS * (high - low) / 2
+        low, high = centre - reach, centre + reach
         if self.box is not None:
-            low = torch.maximum(centre - reach, torch.tensor(self.box[0], dtype=torch.float64))
-            high = torch.minimum(centre + reach, torch.tensor(self.box[1], dtype=torch.float64))
+            low = torch.maximum(low, torch.tensor(self.box[0], dtype=torch.float64))
+            high = torch.minimum(high, torch.tensor(self.box[1], dtype=torch.float64))
         near = low + (high - low) * torch.rand(CONTROL_SAMPLES, len(self.states),
                                                generator=self.generator, dtype=torch.float64)
         return centre, torch.cat([everywhere, near])
