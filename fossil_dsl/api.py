@@ -10,7 +10,8 @@ from fossil_dsl.cegis.learner import import_optimiser_support
 from fossil_dsl.cegis.loop import Cegis
 from fossil_dsl.check.checker import check as _check_tree
 from fossil_dsl.plan import Plan, compile_spec
-from fossil_dsl.result import Result, build_result
+from fossil_dsl.kernel import Verdict, judge, not_certified
+from fossil_dsl.result import Result, build_result, claim_of
 from fossil_dsl.smt import registry
 from fossil_dsl.smt.fallback import FallbackBackend
 from fossil_dsl.diagnostics import Diagnostic, Source, SpecError, has_errors, render_all
@@ -87,7 +88,16 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) ->
     plan = compile_spec(spec, certificate=certificate, **options)
     backend = None if plan.options.learn_only else _backend(plan)
     outcome = Cegis(plan, backend, progress).run()
-    return build_result(plan, outcome, time.monotonic() - started)
+    return build_result(plan, outcome, _judge(plan, outcome), time.monotonic() - started)
+
+
+def _judge(plan: Plan, outcome) -> Verdict:
+    """The kernel's verdict on the engine's final formulas (judged afresh from the spec
+    and those formulas alone; the engine's own answers are not used)."""
+    if not outcome.certified:
+        return not_certified(outcome.reason)
+    return judge(claim_of(plan, outcome), timeout=plan.options.query_timeout,
+                 delta=plan.options.delta)
 
 
 def _backend(plan: Plan):

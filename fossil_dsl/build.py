@@ -13,19 +13,24 @@ sympy expressions are converted node by node.
 from __future__ import annotations
 
 import dataclasses
+from fractions import Fraction
 from typing import Callable, Mapping, Sequence
 
 import sympy
 import torch
 
 from fossil_dsl.check.checker import check as check_tree
+from fossil_dsl.check.context import CheckContext
+from fossil_dsl.check.relations import RelationProver, Subject
 from fossil_dsl.diagnostics import FslError, Source, SpecError, has_errors
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.printing import to_text
-from fossil_dsl.ir.sets import Bespoke, Named, Semialgebraic, SetExpr
+from fossil_dsl.ir.expr import Num
+from fossil_dsl.ir.sets import Bespoke, Box, Intersection, Named, Semialgebraic, SetExpr
 from fossil_dsl.ir.spec import CheckedSpec
 from fossil_dsl.ir.symbolic import SympyConversionError, from_sympy
 from fossil_dsl.learn.evaluate import evaluate, state_env
+from fossil_dsl.smt.z3_backend import Z3Backend
 from fossil_dsl.syntax.parser import parse_source
 
 AGREEMENT_POINTS = 256  # where a torch field is compared with the formulas
@@ -124,8 +129,35 @@ def _set_text(value: SetLike, states: Sequence[str]) -> str:
     if isinstance(value, str):
         return value
     if isinstance(value, BespokeSet):
-        return "{ " + ", ".join(str(c) for c in _constraints(value, states)) + " }"
+        constraints = _constraints(value, states)
+        text = "{ " + ", ".join(str(c) for c in constraints) + " }"
+        if value.box is None:
+            return text
+        _check_inside_box(Semialgebraic(tuple(constraints), tuple(states)), value.box, states)
+        # proved equal to the constraints alone; the box lets the checker see a bound
+        low, high = ("[" + ", ".join(map(_exact_text, side)) + "]" for side in value.box)
+        return f"({text} & box({low}, {high}))"
     raise BuildError(f"a set is .fsl text or a BespokeSet, not {type(value).__name__}")
+
+
+def _exact_text(value: float) -> str:
+    """The number as the user wrote it (0.2, not the double nearest to it)."""
+    return to_text(Num(Fraction(repr(float(value)))))
+
+
+def _check_inside_box(region: Semialgebraic, box, states: Sequence[str]) -> None:
+    """A bespoke set's constraints must lie in its box: every proof is about the
+    constraints, every sample is drawn in the box."""
+    context = CheckContext()
+    context.states.extend(states)
+    low, high = (tuple(Num(Fraction(repr(float(v)))) for v in side) for side in box)
+    query = L.conjunction(region.contains_formula(states), L.negation(
+        Box(low, high).contains_formula(states)))
+    RelationProver(context, states, Z3Backend()).refute(
+        query, f"the bespoke set {region.text()} lies in its box", None)
+    if has_errors(context.diagnostics):
+        raise BuildError("; ".join(d.message for d in context.diagnostics)
+                         + " (its `box` must contain every point of its constraints)")
 
 
 def _constraints(bespoke: BespokeSet, states: Sequence[str]) -> list[L.Compare]:
@@ -147,10 +179,11 @@ def _with_bespoke_sets(spec: CheckedSpec, bespoke: Mapping[str, BespokeSet]) -> 
     for key, value in bespoke.items():
         stand_in = spec.domain if key == "domain" else spec.sets[key]
         stand_in = stand_in.value if isinstance(stand_in, Named) else stand_in
-        assert isinstance(stand_in, Semialgebraic)
+        constraints = stand_in.left if isinstance(stand_in, Intersection) else stand_in
+        assert isinstance(constraints, Semialgebraic)
         box = None if value.box is None else \
             (tuple(map(float, value.box[0])), tuple(map(float, value.box[1])))
-        swaps[id(stand_in)] = Bespoke(stand_in.constraints, stand_in.states, key,
+        swaps[id(stand_in)] = Bespoke(constraints.constraints, constraints.states, key,
                                       value.sample, box)
     if not swaps:
         return spec

@@ -16,6 +16,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.activations import ACTIVATIONS
 from fossil_dsl.ir.spec import CheckedSpec, Layer, TimeDomain
+from fossil_dsl.kernel.obligations import BALL_ROOM
 from fossil_dsl.smt import registry
 from fossil_dsl.smt.smtlib import query_text
 
@@ -34,6 +35,7 @@ class CompileError(FslError):
 
 
 ORIGIN_RADIUS = Fraction(1, 100)  # the reference tool's annulus (its "torus" domains)
+MIN_ORIGIN_RADIUS = Fraction(1, 10 ** 6)
 
 
 @dataclass(frozen=True)
@@ -109,12 +111,24 @@ def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None
     verifier, reason = choose_verifier(spec, functions, controller, requested)
     options = _options(spec, overrides)
     samples = {c.name: _sample_count(spec, c.region) for c in conditions}
-    radius = ORIGIN_RADIUS if registry.BACKENDS[verifier].delta_decision else Fraction(0)
+    radius = origin_radius(spec) if registry.BACKENDS[verifier].delta_decision else Fraction(0)
     fallback = None if requested or spec.synthesis.verifier else _fallback(verifier)
     if fallback:
         reason += f"; where it does not answer at once, {fallback} alongside"
     return Plan(spec, rule, functions, conditions, tuple(rule.levels()), controller,
                 verifier, reason, MappingProxyType(samples), options, radius, fallback)
+
+
+def origin_radius(spec: CheckedSpec) -> Fraction:
+    """The ball a delta-decision verifier leaves out round the origin: ORIGIN_RADIUS, or
+    a power of ten small enough that ten times it fits in the domain's box (the kernel
+    proves that the larger ball lies in D)."""
+    box = spec.domain.bounding_box()
+    room = min(min(-low, high) for low, high in zip(*box)) if box else 0.0
+    radius = ORIGIN_RADIUS
+    while BALL_ROOM * radius > room and radius > MIN_ORIGIN_RADIUS:
+        radius /= 10
+    return radius
 
 
 def _fallback(verifier: str) -> str | None:

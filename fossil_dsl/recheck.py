@@ -15,6 +15,7 @@ from pathlib import Path
 from fossil_dsl.diagnostics import FslError
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
+from fossil_dsl.kernel.obligations import file_stem
 from fossil_dsl.smt import registry
 from fossil_dsl.smt.api import Status
 from fossil_dsl.smt.smtlib_reader import SmtlibError, read_script
@@ -59,8 +60,12 @@ def _solvers_used(folder: Path) -> dict[str, str]:
         data = json.loads((folder / "result.json").read_text())
     except (OSError, ValueError) as exc:
         raise RecheckError(f"{folder}: cannot read result.json ({exc})") from exc
-    return {c["name"]: c.get("solver", "") for c in data.get("conditions", [])
+    used = {c["name"]: c.get("solver", "") for c in data.get("conditions", [])
             if c.get("status") == "unsat"}
+    kernel = data.get("kernel", {}).get("obligations", [])
+    used.update({file_stem(o["name"]): o.get("procedure", "") for o in kernel
+                 if o.get("outcome") == "proved"})
+    return used
 
 
 def _recheck_one(path: Path, used: str, timeout: float, wanted: str | None) -> Recheck:

@@ -15,9 +15,12 @@ from fossil_dsl.version import __version__
 from fossil_dsl.cegis.loop import CegisOutcome
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir.symbolic import to_sympy
+from fossil_dsl.kernel import Claim, NoRule, Verdict, not_certified
+from fossil_dsl.kernel import list_obligations as kernel_obligations
 from fossil_dsl.plan import Plan
 from fossil_dsl.plot import phase_portrait
 from fossil_dsl.smt import registry
+from fossil_dsl.smt.api import UnsupportedTheory
 from fossil_dsl.smt.smtlib import query_text
 
 SCHEMA_VERSION = 2  # docs/result-schema.md; 2 added networks, versions, certificate kind
@@ -49,6 +52,7 @@ class Result:
     total_seconds: float
     digits: int = 3  # decimals the network weights were rounded to
     networks: dict = field(default_factory=dict)  # name -> trained torch module ("k": controller)
+    kernel: Verdict = field(default_factory=lambda: not_certified("not judged"))
 
     @property
     def verdict(self) -> str:
@@ -134,6 +138,7 @@ class Result:
             "levels": {name: str(v) for name, v in self.levels.items()},
             "learn_only": self.learn_only,
             "conditions": [_condition_json(c) for c in self.conditions],
+            "kernel": kernel_json(self.kernel),
             "verifier": plan.verifier,
             "fallback": plan.fallback,
             "iterations": self.iterations,
@@ -143,6 +148,33 @@ class Result:
                         "total": _seconds(self.total_seconds)},
             "versions": versions(),
         }
+
+
+def kernel_json(verdict: Verdict) -> dict:
+    """The kernel's verdict and each obligation it decided, with its procedure."""
+    return {"verdict": "certified" if verdict.certified else "not certified",
+            "reason": verdict.reason, "seconds": _seconds(verdict.seconds),
+            "obligations": [{"name": p.obligation.name, "text": p.obligation.text,
+                             "outcome": p.outcome.value, "procedure": p.procedure,
+                             "detail": p.detail, "witness": None if p.witness is None
+                             else [str(v) for v in p.witness]} for p in verdict.proofs]}
+
+
+def kernel_lines(verdict: Verdict) -> list[str]:
+    """The side facts the kernel proved (the conditions are listed above them), and a
+    tally of its procedures."""
+    if not verdict.proofs:
+        return []
+    lines = [f"  [proved by {p.procedure}] {p.obligation.text}" for p in verdict.proofs
+             if p.proved and not p.obligation.name.startswith("condition:")]
+    tally: dict[str, int] = {}
+    for proof in verdict.proofs:
+        tally[proof.procedure] = tally.get(proof.procedure, 0) + proof.proved
+    used = ", ".join(f"{name} {count}" for name, count in tally.items())
+    done = sum(p.proved for p in verdict.proofs)
+    lines.append(f"  kernel: {done} of {len(verdict.proofs)} obligations proved from the "
+                 f"spec and the exact formulas ({used}) in {verdict.seconds:.2f} s")
+    return lines
 
 
 def network_json(network, digits: int) -> dict:
@@ -191,21 +223,54 @@ def _condition_json(report: ConditionReport) -> dict:
             "reason": report.reason, "counterexample": point, "solver": report.solver}
 
 
-def build_result(plan: Plan, outcome: CegisOutcome, total_seconds: float) -> Result:
+def claim_of(plan: Plan, outcome: CegisOutcome) -> Claim:
+    """What the engine proposes to the kernel: the spec and the final exact formulas."""
+    candidate = outcome.candidate
+    return Claim(plan.spec, dict(candidate.formulas), dict(candidate.controller),
+                 dict(candidate.levels), plan.origin_radius)
+
+
+def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
+                 total_seconds: float) -> Result:
+    """The result of a run; certified exactly when the kernel's verdict is."""
     texts = {c.name: c.text for c in plan.conditions}
     reports = tuple(ConditionReport(v.condition, texts[v.condition],
                                     "not verified" if plan.options.learn_only else v.status.value,
                                     v.reason, v.counterexample, v.solver or plan.verifier)
                     for v in outcome.verdicts)
     candidate = outcome.candidate
-    return Result(plan, outcome.certified, outcome.reason, dict(candidate.formulas),
+    reason = outcome.reason
+    if outcome.certified and not verdict.certified:
+        reason = f"the engine proved its conditions, but the kernel did not certify: " \
+            f"{verdict.reason}"
+    return Result(plan, verdict.certified, reason, dict(candidate.formulas),
                   dict(candidate.controller), dict(candidate.levels), reports,
                   obligations(plan, outcome), len(outcome.history), outcome.learn_seconds,
                   outcome.verify_seconds, total_seconds, candidate.digits,
-                  dict(outcome.networks))
+                  dict(outcome.networks), verdict)
 
 
 def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
+    """The kernel's obligations for the final formulas as SMT-LIB 2 scripts (unsat
+    means proved); the engine's condition queries where the kernel has no rule."""
+    try:
+        found = kernel_obligations(claim_of(plan, outcome))
+    except NoRule:
+        return condition_scripts(plan, outcome)
+    scripts = {}
+    for obligation in found:
+        comments = [f"{plan.spec.name}: {obligation.name}: {obligation.text}",
+                    "unsat means the obligation holds"]
+        try:
+            scripts[obligation.file_stem] = query_text(obligation.query, plan.states,
+                                                       comments=comments)
+        except UnsupportedTheory as exc:  # e.g. a power SMT-LIB cannot write
+            scripts[obligation.file_stem] = f"; {comments[0]}\n; not expressible " \
+                f"in SMT-LIB 2: {exc}\n"
+    return scripts
+
+
+def condition_scripts(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
     """Each condition's query with the certificate as a named, defined function."""
     candidate = outcome.candidate
     functions = {}
@@ -248,6 +313,7 @@ def summary_text(result: Result) -> str:
         elif report.reason:
             extra = f" ({report.reason})"
         lines.append(f"  [{mark}] {report.text}{extra}")
+    lines += kernel_lines(result.kernel)
     if result.learn_only:
         lines.append("  learn-only: NOTHING WAS PROVED; the rates above are of fresh samples "
                      "that violate each condition, which no verifier has checked")

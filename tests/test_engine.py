@@ -10,6 +10,7 @@ import torch
 import fossil_dsl
 from fossil_dsl.cegis.loop import Cegis
 from fossil_dsl.plan import compile_spec, loss_text, plan_text, symbolic_queries
+from fossil_dsl.kernel import not_certified
 from fossil_dsl.result import build_result, write_artefacts
 from fossil_dsl.smt.api import Answer, Status
 from fossil_dsl.smt.cvc5_backend import Cvc5Backend
@@ -40,7 +41,9 @@ def test_bundled_specs_are_certified_with_defaults(name, tmp_path):
     write_artefacts(result, tmp_path)
     other = OTHER_SOLVER[result.plan.verifier]()
     files = sorted((tmp_path / "obligations").glob("*.smt2"))
-    assert {f.stem for f in files} == {c.name for c in result.plan.conditions}
+    # they are the kernel's obligations, every one of which it proved
+    assert {f.stem for f in files} == {p.obligation.file_stem for p in result.kernel.proofs}
+    assert {f"condition-{c.name}" for c in result.plan.conditions} <= {f.stem for f in files}
     for path in files:
         answer = other.check_text(path.read_text(), timeout=60)
         assert answer.status is Status.UNSAT, (path.name, answer)
@@ -118,7 +121,7 @@ def test_loop_only_certifies_on_unsat(status):
     outcome = Cegis(plan, ScriptedBackend(status)).run()
     assert not outcome.certified
     assert all(v.status is status for v in outcome.verdicts)
-    result = build_result(plan, outcome, 0.0)
+    result = build_result(plan, outcome, not_certified(outcome.reason), 0.0)
     assert result.verdict == "not certified"
 
 
@@ -161,7 +164,7 @@ def test_run_writes_artefacts_with_o(tmp_path):
                          text=True, timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr
     assert (tmp_path / "out" / "result.json").exists()
-    assert (tmp_path / "out" / "obligations" / "decrease.smt2").exists()
+    assert (tmp_path / "out" / "obligations" / "condition-decrease.smt2").exists()
 
 
 @pytest.mark.parametrize("prove", ["from init: stable", "from init: safe until goal",

@@ -217,7 +217,7 @@ dynamics discrete {
     next(x0) = 0.5*x0
     next(x1) = 0.5*x1 + 0.1*x0
 }
-domain { x0^2 + x1^2 <= 4 }
+domain { x0^2 + x1^2 <= 4, -2 <= x0, x0 <= 2, -2 <= x1, x1 <= 2 }
 set init = { x0^2 + x1^2 <= 1, x0 >= -0.5 }
 prove from init: stable
 synthesis {

@@ -52,6 +52,9 @@ def recheck_from_text(result) -> None:
     interval verifier, and CVC5 never finds it satisfiable."""
     for name, script in result.obligations.items():
         read = read_script(script)
+        if not L.free_vars(read.formula):  # a fact about numbers (f(0) = 0): no box
+            assert Z3Backend().check_text(script, timeout=10).status is Status.UNSAT, name
+            continue
         answer = IntervalBackend().check(read.formula, read.variables, timeout=120)
         assert answer.status is Status.UNSAT, (name, answer)
         assert Cvc5Backend().check_text(script, timeout=2).status is not Status.SAT, name

@@ -13,6 +13,7 @@ import pytest
 import fossil_dsl
 from fossil_dsl.certificates import base as certificate_registry
 from fossil_dsl.check import properties
+from fossil_dsl.kernel import obligations as kernel_obligations
 from fossil_dsl.plan import compile_spec
 from fossil_dsl.result import write_artefacts
 from fossil_dsl.smt.api import Status
@@ -309,7 +310,10 @@ def test_compile_explain_names_certificate_conditions_and_guarantee(name):
 def registries():
     forms = list(properties.FORMS)
     rules = dict(certificate_registry.CERTIFICATES)
+    kernel_rules = dict(kernel_obligations.RULES)
     yield
+    kernel_obligations.RULES.clear()
+    kernel_obligations.RULES.update(kernel_rules)
     properties.FORMS[:] = forms
     certificate_registry.CERTIFICATES.clear()
     certificate_registry.CERTIFICATES.update(rules)

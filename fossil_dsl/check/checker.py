@@ -233,7 +233,11 @@ class Checker:
 
     def prove_facts(self, form, prop, domain, dynamics, equation_spans, time) -> None:
         prover = RelationProver(self.context, self.context.states, Z3Backend())
-        prover.nonempty(Subject(domain, "the domain", self.spans.get("domain")))
+        domain_subject = Subject(domain, "the domain", self.spans.get("domain"))
+        prover.nonempty(domain_subject)
+        prover.bounded(domain_subject)
+        if form.stable_type:
+            prover.origin_interior(domain_subject)
         for value in {id(v): v for v in prop.roles.values()}.values():
             if isinstance(value, S.Named):  # the sets the property names must not be empty
                 prover.nonempty(self.subject(value))

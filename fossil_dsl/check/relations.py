@@ -6,8 +6,9 @@ arithmetic, or by an outward-rounded enclosure that excludes 0.
 """
 from __future__ import annotations
 
+import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from decimal import Decimal, localcontext
 from fractions import Fraction
 from typing import Sequence
@@ -19,6 +20,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.enclosure import sign
 from fossil_dsl.ir.printing import number_text, to_text
+from fossil_dsl.smt import registry
 from fossil_dsl.smt.api import Answer, Backend, Status
 
 RELATION_TIMEOUT = 2.5  # seconds per query
@@ -57,25 +59,45 @@ class RelationProver:
         self.deadline = time.monotonic() + budget
 
     def _decide(self, formula: L.Formula) -> Answer:
+        """The backend's answer; where it has none, the interval procedure's (loaded
+        only then: most relations are polynomial)."""
+        answer = self._ask(self.backend, formula)
+        if answer.status is Status.UNKNOWN and registry.is_installed("interval"):
+            second = self._ask(registry.load("interval"), formula)
+            if second.status is not Status.UNKNOWN:
+                return replace(second, solver="the interval procedure")
+            answer = Answer(Status.UNKNOWN, reason=f"{answer.reason}; interval: "
+                            f"{second.reason}")
+        return answer
+
+    def _ask(self, backend: Backend, formula: L.Formula) -> Answer:
         remaining = self.deadline - time.monotonic()
         if remaining <= 0.05:
             return Answer(Status.UNKNOWN, reason="the time for checking set relations "
                           f"({RELATION_BUDGET:g} s) is spent")
-        return self.backend.check(formula, self.states, min(self.timeout, remaining))
+        return backend.check(formula, self.states, min(self.timeout, remaining))
 
     def _member(self, subject: Subject) -> L.Formula:
         return subject.value.contains_formula(self.states)
 
     def _query(self, formula: L.Formula, claim: str, span: Span | None):
-        """A witness if `formula` is satisfiable; None if UNSAT or undecided (warned)."""
+        """A witness if `formula` is satisfiable; None if UNSAT. Undecided is an error:
+        the guarantee would rest on a fact nobody proved."""
         answer = self._decide(formula)
         if answer.status is Status.UNSAT:
             return None
         if answer.status is Status.SAT and not answer.approximate:
             return [answer.model[name] for name in self.states]
-        why = answer.reason or ("constants such as pi were only bounded, and the bounded "
-                                "query has a solution")
-        self.context.warning(f"could not prove that {claim} ({self.backend.name}: {why})", span)
+        if answer.status is Status.SAT:
+            near = point_text([answer.model.get(name, 0) for name in self.states])
+            why = f"{answer.solver or 'a solver'} found a point near {near} where it may " \
+                "fail, but could not decide it exactly" + (f" ({answer.reason})"
+                                                           if answer.reason else "")
+        else:
+            why = answer.reason or "no answer"
+        self.context.error(f"cannot prove that {claim}: {why}; every relation the "
+                           "guarantee uses must be proved (rewrite the sets so that a "
+                           "solver can decide it)", span)
         return None
 
     def inside(self, a: Subject, b: Subject) -> None:
@@ -113,6 +135,39 @@ class RelationProver:
             self.context.error(f"{a.text} does not contain the origin, the equilibrium that "
                                "the controller (with k(0) = 0) keeps", a.span)
 
+    def refute(self, query: L.Formula, claim: str, span: Span | None) -> None:
+        """An error unless `query` is proved unsatisfiable."""
+        witness = self._query(query, claim, span)
+        if witness is not None:
+            self.context.error(f"it is not true that {claim}: {point_text(witness)} is a "
+                               "counterexample", span)
+
+    def bounded(self, a: Subject) -> None:
+        """The set lies in its bounding box (every proof and every sample needs one)."""
+        box = a.value.bounding_box()
+        if box is None or not all(math.isfinite(v) for v in (*box[0], *box[1])):
+            self.context.error(f"{a.text} must be bounded, and no bound can be read from "
+                               "it: intersect it with a box, e.g. `{ ... } & box([-1, -1], "
+                               "[1, 1])`", a.span)
+            return
+        lower, upper = (tuple(E.Num(Fraction(v)) for v in side) for side in box)
+        query = L.conjunction(self._member(a), L.negation(S.Box(lower, upper).contains_formula(
+            self.states)))
+        witness = self._query(query, f"{a.text} is bounded", a.span)
+        if witness is not None:
+            self.context.error(f"{a.text} is not inside its bounding box: "
+                               f"{point_text(witness)} is in it", a.span)
+
+    def origin_interior(self, a: Subject) -> None:
+        """The origin is an interior point (stable-type properties need a neighbourhood
+        of the equilibrium)."""
+        inner = L.substitute(L.open_inner(self._member(a)), {s: E.ZERO for s in self.states})
+        if self._query(L.negation(inner), f"the origin is an interior point of {a.text}",
+                       a.span) is not None:
+            self.context.error(f"{a.text} contains no neighbourhood of the origin, so it "
+                               "cannot show that the origin is stable (a domain with a hole "
+                               "round the origin, or without the origin)", a.span)
+
     def nonempty(self, a: Subject) -> None:
         answer = self._decide(self._member(a))
         if answer.status is Status.UNSAT:
@@ -140,9 +195,12 @@ def check_equilibrium(context: CheckContext, states: Sequence[str], inputs: Sequ
         verdict = sign(at_origin) if not E.free_vars(at_origin) else None
         if verdict == 0:
             continue
-        if verdict is None:
+        if verdict is None and inputs:
             context.warning(f"could not prove {where} = 0 for {lhs} (= {to_text(at_origin)} "
                             "at the origin)", span)
+        elif verdict is None:
+            context.error(f"cannot prove that the origin is an equilibrium: {lhs} = "
+                          f"{to_text(at_origin)} at x = 0 could not be decided exactly", span)
         elif inputs:
             context.warning(f"the origin is not an equilibrium of the open loop: {lhs} = "
                             f"{to_text(at_origin)} at x = 0, u = 0", span)

@@ -55,11 +55,12 @@ def rational_interval(value: Fraction):
     """The smallest double interval containing an exact rational (call under
     upward_rounding)."""
     codac = _codac()[0]
-    near = float(value) if abs(value) < Fraction(10) ** 300 else math.copysign(math.inf, value)
+    if abs(value) >= Fraction(10) ** 300:
+        low, high = (-math.inf, -1e300) if value < 0 else (1e300, math.inf)
+        return codac.Interval(low, high)
+    near = float(value)
     low = near if Fraction(near) <= value else math.nextafter(near, -math.inf)
     high = near if Fraction(near) >= value else math.nextafter(near, math.inf)
-    if math.isinf(near):
-        low, high = (-math.inf, -1e300) if value < 0 else (1e300, math.inf)
     return codac.Interval(low, high)
 
 
@@ -90,8 +91,19 @@ def _enclose(expr: E.Expr):
     if isinstance(expr, E.Pow):
         return _power(_enclose(expr.base), expr.exponent)
     if isinstance(expr, E.Apply):
-        return getattr(codac, expr.func)(_enclose(expr.arg))
+        return function(expr.func, _enclose(expr.arg))
     raise ValueError(f"cannot enclose {expr!r}: it has variables")
+
+
+def function(name: str, argument):
+    """codac's `name` applied to an interval or an analytic expression, outward-rounded.
+    codac's own tanh is not (it misses the true value by an ulp at about 2% of points),
+    so tanh is built from exp, whose enclosures are: 1 - 2 / (exp(2z) + 1).
+    tests/test_soundness.py compares every function with mpmath at 100 digits."""
+    codac = _codac()[0]
+    if name == "tanh":
+        return 1 - 2 / (codac.exp(2 * argument) + 1)
+    return getattr(codac, name)(argument)
 
 
 def _fold(items, combine):

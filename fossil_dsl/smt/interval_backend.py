@@ -24,7 +24,7 @@ from typing import Sequence
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
-from fossil_dsl.ir.enclosure import rational_interval, upward_rounding
+from fossil_dsl.ir.enclosure import function, rational_interval, upward_rounding
 from fossil_dsl.smt.api import Answer, Status, UnsupportedTheory
 
 DELTA = 1e-4  # the width under which a surviving box counts as a (delta-)solution
@@ -220,7 +220,7 @@ class _Compiler:
         if isinstance(expr, E.Apply):
             if not hasattr(codac, expr.func):
                 raise UnsupportedTheory(f"the interval verifier has no `{expr.func}`")
-            return getattr(codac, expr.func)(self.expr(expr.arg))
+            return function(expr.func, self.expr(expr.arg))
         raise UnsupportedTheory(f"cannot translate {expr!r}")
 
     def power(self, expr: E.Pow):

@@ -1,0 +1,13 @@
+"""The proof kernel: the only part of fossil_dsl that can say CERTIFIED.
+
+It takes the checked spec and the final exact functions (a `Claim`), derives every
+obligation the guarantee rests on (`obligations.py`, `rules.py`, `definedness.py`),
+discharges each with a sound procedure (`prove.py`) and returns the verdict
+(`verdict.py`). It imports the IR and the solvers only: no torch, no learner.
+"""
+from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation
+from fossil_dsl.kernel.prove import Outcome, Proof
+from fossil_dsl.kernel.verdict import Verdict, judge, list_obligations, not_certified
+
+__all__ = ["Claim", "NoRule", "Obligation", "Outcome", "Proof", "Verdict", "judge",
+           "list_obligations", "not_certified"]

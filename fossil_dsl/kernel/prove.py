@@ -1,0 +1,98 @@
+"""Discharging one obligation with a sound procedure.
+
+- A query whose comparisons are between numbers is decided by exact rational arithmetic.
+- Arithmetic queries (polynomials, division, integer powers, abs) go to Z3 on exact
+  rationals, then CVC5 if Z3 does not answer. Irrational constants (pi, sqrt(2)) are
+  replaced by variables bounded by an outward-rounded enclosure, so an UNSAT holds for
+  the true constant too.
+- Other queries go to the interval procedure (codac contractors and bisection on
+  outward-rounded arithmetic, every elementary function checked against mpmath by the
+  tests). Only its UNSAT is used; a box it cannot refute is "not proved", never a proof.
+
+Whatever a procedure says other than UNSAT (a counterexample, delta-SAT, UNKNOWN, a
+timeout) leaves the obligation unproved.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from fractions import Fraction
+from typing import Sequence
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.kernel.obligations import Obligation
+from fossil_dsl.smt.api import Answer, Status
+
+
+class Outcome(Enum):
+    PROVED = "proved"
+    FAILS = "fails"  # a point where the fact is false
+    NOT_PROVED = "not proved"  # undecided: UNKNOWN, timeout, or a delta-SAT box
+
+
+@dataclass(frozen=True)
+class Proof:
+    obligation: Obligation
+    outcome: Outcome
+    procedure: str
+    detail: str = ""
+    witness: tuple[Fraction, ...] | None = None
+
+    @property
+    def proved(self) -> bool:
+        return self.outcome is Outcome.PROVED
+
+
+def is_arithmetic(formula: L.Formula) -> bool:
+    return all(E.is_arithmetic(side) for c in L.comparisons(formula)
+               for side in (c.left, c.right))
+
+
+def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
+              delta: float | None = None) -> Proof:
+    query = obligation.query
+    exact = L.truth(query)
+    if exact is not None:
+        outcome = Outcome.FAILS if exact else Outcome.PROVED
+        return Proof(obligation, outcome, "exact arithmetic")
+    if is_arithmetic(query):
+        return _complete(obligation, states, timeout)
+    return _interval(obligation, states, timeout, delta)
+
+
+def _complete(obligation: Obligation, states, timeout: float) -> Proof:
+    from fossil_dsl.smt.cvc5_backend import Cvc5Backend
+    from fossil_dsl.smt.z3_backend import Z3Backend
+    reasons = []
+    for backend in (Z3Backend(), Cvc5Backend()):
+        answer = backend.check(obligation.query, states, timeout)
+        if answer.status is Status.UNSAT:
+            return Proof(obligation, Outcome.PROVED, backend.name)
+        if answer.status is Status.SAT and not answer.approximate:
+            return Proof(obligation, Outcome.FAILS, backend.name, "counterexample",
+                         _point(answer, states))
+        reasons.append(f"{backend.name}: {_reason(answer)}")
+    return Proof(obligation, Outcome.NOT_PROVED, "z3, cvc5", "; ".join(reasons))
+
+
+def _interval(obligation: Obligation, states, timeout: float, delta) -> Proof:
+    from fossil_dsl.smt.interval_backend import IntervalBackend
+    backend = IntervalBackend(delta) if delta else IntervalBackend()
+    answer = backend.check(obligation.query, states, timeout)
+    if answer.status is Status.UNSAT:
+        return Proof(obligation, Outcome.PROVED, "interval")
+    return Proof(obligation, Outcome.NOT_PROVED, "interval", _reason(answer),
+                 _point(answer, states))
+
+
+def _point(answer: Answer, states) -> tuple[Fraction, ...] | None:
+    if not answer.model:
+        return None
+    return tuple(Fraction(answer.model.get(s, 0)) for s in states)
+
+
+def _reason(answer: Answer) -> str:
+    if answer.status is Status.SAT:
+        return answer.reason or "a solution whose coordinates are only approximate"
+    return answer.reason or answer.status.value

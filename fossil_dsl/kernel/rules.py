@@ -1,0 +1,188 @@
+"""The kernel's rule per property form and time domain (docs/certificates.md has the
+argument for each). A rule lists every obligation: the conditions on the functions and
+the side facts the argument uses. Definedness of what a condition evaluates is added
+by `Facts.never` itself.
+"""
+from __future__ import annotations
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.kernel.obligations import BALL_ROOM, GAMMA, Facts, Obligation, rule
+
+CONTINUOUS, DISCRETE = TimeDomain.CONTINUOUS, TimeDomain.DISCRETE
+ZERO = E.ZERO
+
+
+def compare(relation: str, left: E.Expr, right: E.Expr = ZERO) -> L.Formula:
+    return L.Compare(relation, left, right)
+
+
+def nonzero(value: E.Expr) -> L.Formula:
+    return L.disjunction(compare("<", value), compare(">", value))
+
+
+# ---- stable-type side facts ------------------------------------------------------
+def equilibrium(facts: Facts, function: str) -> None:
+    """f(0) = 0 for the closed loop, and V(0) = 0."""
+    origin = {s: ZERO for s in facts.states}
+    named = [(f"f{i}(0) = 0 (the origin is an equilibrium)", f"equilibrium:{s}", f)
+             for i, (s, f) in enumerate(zip(facts.states, facts.field))]
+    named.append((f"{function}(0) = 0", f"origin:{function}", facts.value(function)))
+    for text, name, expression in named:
+        try:
+            query = nonzero(E.substitute(expression, origin))
+        except E.ExprError as exc:  # undefined at the origin: the fact fails
+            text, query = f"{text}; but it is undefined there ({exc})", L.TRUE
+        facts.obligations.append(Obligation(name, text, query))
+
+
+def neighbourhood(facts: Facts) -> None:
+    """The origin is an interior point of D; with an excluded ball of radius r, the
+    ball of radius BALL_ROOM * r lies in D (the ball is small next to the domain)."""
+    domain = facts.member(facts.spec.domain)
+    at_origin = L.substitute(L.open_inner(domain), {s: ZERO for s in facts.states})
+    facts.obligations.append(Obligation(
+        "neighbourhood", "the origin is an interior point of D (D contains a "
+        "neighbourhood of it)", L.negation(at_origin)))
+    if facts.r > 0:
+        radius = BALL_ROOM * facts.r
+        facts.inside("ball:room", f"the ball |x| <= {radius} ({BALL_ROOM} times the "
+                     "excluded ball) lies in D", facts.ball(radius), domain)
+    if facts.r > 0 and facts.discrete:
+        image = E.add(*(E.power(f, E.Num(2)) for f in facts.field))
+        facts.never("ball:image", f"the map sends the excluded ball |x| <= {facts.r} into "
+                    "itself", facts.ball(facts.r), compare(">", image, E.Num(facts.r ** 2)))
+
+
+def away_words(facts: Facts) -> str:
+    return f"|x| > {facts.r}" if facts.r > 0 else "x ≠ 0"
+
+
+def lyapunov_conditions(facts: Facts, region: L.Formula, words: str) -> None:
+    V, dV = facts.value("V"), facts.change("V")
+    away = L.conjunction(region, facts.away_from_origin())
+    change = "V(f(x)) - V(x)" if facts.discrete else "dV/dt"
+    facts.holds("condition:positive", f"V(x) > 0 for x in {words}, {away_words(facts)}",
+                away, compare(">", V))
+    facts.holds("condition:decrease", f"{change} < 0 for x in {words}, {away_words(facts)}",
+                away, compare("<", dV))
+
+
+@rule("stability", CONTINUOUS, DISCRETE)
+def stability(facts: Facts) -> None:
+    equilibrium(facts, "V")
+    neighbourhood(facts)
+    # on the closure: a trajectory that remains in D has its limit points there
+    lyapunov_conditions(facts, facts.closure(facts.spec.domain), "the closure of D")
+
+
+def region_of_attraction(facts: Facts) -> None:
+    equilibrium(facts, "V")
+    neighbourhood(facts)
+    V, beta = facts.value("V"), facts.level("beta")
+    domain, initial = facts.spec.domain, facts.role("initial")
+    facts.inside("relation:initial in domain", "I lies in D", facts.member(initial),
+                 facts.member(domain))
+    facts.holds("condition:boundary", "V(x) > β on the boundary of D",
+                facts.boundary(domain), compare(">", V, beta))
+    facts.holds("condition:initial", "V(x) <= β on I", facts.member(initial),
+                compare("<=", V, beta))
+    omega = L.conjunction(facts.closure(domain), compare("<=", V, beta))
+    lyapunov_conditions(facts, omega, "Ω = {x in D : V(x) <= β}")
+    facts.obligations.append(Obligation("level:beta", "β > 0", compare("<=", beta)))
+    if facts.r > 0:
+        facts.holds("ball:sublevel", f"V(x) < β on the excluded ball |x| <= {facts.r}, "
+                    "so no trajectory leaves Ω through it", facts.ball(facts.r),
+                    compare("<", V, beta))
+
+
+rule("region of attraction")(region_of_attraction)
+
+
+def barrier_conditions(facts: Facts, name: str, inside: L.Formula, outside: L.Formula,
+                       inside_words: str, outside_words: str, prefix: str = "") -> None:
+    B, dB = facts.value(name), facts.change(name)
+    domain = facts.member(facts.spec.domain)
+    facts.holds(f"condition:{prefix}initial", f"{name}(x) <= 0 on {inside_words}", inside,
+                compare("<=", B))
+    facts.holds(f"condition:{prefix}unsafe", f"{name}(x) > 0 on {outside_words} within D",
+                L.conjunction(outside, domain), compare(">", B))
+    if facts.discrete:
+        facts.holds(f"condition:{prefix}invariance", f"{name}(f(x)) <= 0 for x in D with "
+                    f"{name}(x) <= 0", L.conjunction(domain, compare("<=", B)),
+                    compare("<=", E.add(dB, B)))
+    else:
+        level = L.conjunction(domain, compare("<=", B), compare(">=", B))
+        facts.holds(f"condition:{prefix}flow", f"d{name}/dt < 0 for x in D with "
+                    f"{name}(x) = 0", level, compare("<", dB))
+
+
+@rule("safety", CONTINUOUS, DISCRETE)
+def safety(facts: Facts) -> None:
+    initial, unsafe = facts.member(facts.role("initial")), facts.member(facts.role("unsafe"))
+    facts.inside("relation:initial in domain", "I lies in D", initial,
+                 facts.member(facts.spec.domain))
+    facts.disjoint("relation:initial and unsafe", "I and U are disjoint", initial, unsafe)
+    barrier_conditions(facts, "B", initial, unsafe, "I", "U")
+
+
+@rule("stable while avoid")
+def stable_while_avoid(facts: Facts) -> None:
+    region_of_attraction(facts)
+    initial, unsafe = facts.member(facts.role("initial")), facts.member(facts.role("unsafe"))
+    facts.disjoint("relation:initial and unsafe", "I and U are disjoint", initial, unsafe)
+    barrier_conditions(facts, "B", initial, unsafe, "I", "U", prefix="barrier_")
+
+
+def reach_while_avoid(facts: Facts, goal_role: str) -> None:
+    V, dV = facts.value("V"), facts.change("V")
+    safe, goal = facts.role("safe"), facts.role(goal_role)
+    initial = facts.member(facts.role("initial"))
+    facts.bounded("safe", "the safe set S", safe)
+    facts.inside("relation:initial in interior of safe", "I lies in the interior of S",
+                 initial, facts.interior(safe))
+    # V is continuous on the compact closure of S, so it is bounded below there
+    facts.defined("V on the closure of S", facts.closure(safe), [V])
+    facts.holds("condition:initial", "V(x) <= 0 on I", initial, compare("<=", V))
+    facts.holds("condition:boundary", "V(x) > 0 on the boundary of S",
+                facts.boundary(safe), compare(">", V))
+    outside_goal = L.conjunction(facts.member(safe), L.negation(facts.member(goal)),
+                                 compare("<=", V))
+    facts.holds("condition:decrease", f"dV/dt <= -{GAMMA} in S outside "
+                f"{'G' if goal_role == 'goal' else 'F'} where V(x) <= 0", outside_goal,
+                compare("<=", dV, E.Num(-GAMMA)))
+
+
+@rule("reach while avoid")
+def reach(facts: Facts) -> None:
+    reach_while_avoid(facts, "goal")
+    facts.inside("relation:goal in interior of safe", "G lies in the interior of S",
+                 facts.member(facts.role("goal")), facts.interior(facts.role("safe")))
+
+
+rule("reach")(reach)  # the checker makes the safe set the domain
+
+
+@rule("reach and stay while avoid")
+def reach_and_stay(facts: Facts) -> None:
+    reach_while_avoid(facts, "final")
+    V, dV, beta = facts.value("V"), facts.change("V"), facts.level("beta")
+    final = facts.role("final")
+    facts.disjoint("relation:final and unsafe", "F and U are disjoint", facts.member(final),
+                   facts.member(facts.role("unsafe")))
+    facts.holds("condition:stay_boundary", "V(x) > β on the boundary of F",
+                facts.boundary(final), compare(">", V, beta))
+    facts.holds("condition:stay_decrease", f"dV/dt <= -{GAMMA} in F where V(x) >= β",
+                L.conjunction(facts.member(final), compare(">=", V, beta)),
+                compare("<=", dV, E.Num(-GAMMA)))
+
+
+@rule("reach-avoid-remain")
+def reach_avoid_remain(facts: Facts) -> None:
+    reach(facts)
+    goal, final = facts.member(facts.role("goal")), facts.member(facts.role("final"))
+    facts.inside("relation:goal in final", "G lies in F", goal, final)
+    facts.disjoint("relation:final and unsafe", "F and U are disjoint", final,
+                   facts.member(facts.role("unsafe")))
+    barrier_conditions(facts, "B", goal, L.negation(final), "G", "D \\ F", prefix="barrier_")

@@ -1,0 +1,73 @@
+"""The verdict: CERTIFIED exactly when every obligation of the claim is proved.
+
+`judge` is the only place a certified Verdict is made: the constructor refuses
+`certified=True` without this module's seal, so nothing the learner, the loop or a
+heuristic does can produce one.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from fossil_dsl.kernel import rules  # noqa: F401  (registers the rules)
+from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation, derive
+from fossil_dsl.kernel.prove import Outcome, Proof, discharge
+
+_SEAL = object()
+OBLIGATION_TIMEOUT = 60.0  # seconds per obligation; running out is "not proved"
+
+
+@dataclass(frozen=True)
+class Verdict:
+    certified: bool
+    reason: str
+    proofs: tuple[Proof, ...] = ()
+    seconds: float = 0.0
+    _seal: object = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self):
+        if self.certified and self._seal is not _SEAL:
+            raise PermissionError("only the kernel's judge() makes a certified verdict")
+
+    @property
+    def failed(self) -> tuple[Proof, ...]:
+        return tuple(p for p in self.proofs if not p.proved)
+
+
+def not_certified(reason: str) -> Verdict:
+    return Verdict(False, reason)
+
+
+def list_obligations(claim: Claim) -> list[Obligation]:
+    """Every obligation of the claim (raises NoRule where the kernel has no rule)."""
+    return derive(claim)
+
+
+def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
+          delta: float | None = None) -> Verdict:
+    """Prove every obligation; stop at the first that is not proved."""
+    started = time.monotonic()
+    try:
+        found = derive(claim)
+    except NoRule as exc:
+        return not_certified(f"the kernel cannot judge this claim: {exc}")
+    proofs = []
+    for obligation in found:
+        proof = discharge(obligation, claim.spec.states, timeout, delta)
+        proofs.append(proof)
+        if not proof.proved:
+            return Verdict(False, _failure_text(proof), tuple(proofs),
+                           time.monotonic() - started)
+    return Verdict(True, f"all {len(proofs)} obligations proved", tuple(proofs),
+                   time.monotonic() - started, _SEAL)
+
+
+def _failure_text(proof: Proof) -> str:
+    obligation = proof.obligation
+    where = ""
+    if proof.witness is not None:
+        where = " at (" + ", ".join(format(float(v), ".6g") for v in proof.witness) + ")"
+    word = "fails" if proof.outcome is Outcome.FAILS else "is not proved"
+    detail = f" ({proof.procedure}: {proof.detail})" if proof.detail else \
+        f" ({proof.procedure})"
+    return f"{obligation.name} ({obligation.text}) {word}{where}{detail}"
