@@ -708,7 +708,7 @@ dynamics continuous {
     x0' = x1 - x0^3
     x1' = u0
 }
-domain ball([0, 0], 1) - ball([0, 0], 0.01)
+domain ball([0, 0], 1)
 prove stable
 synthesis {
     certificate: sigmoid(5), square(5)

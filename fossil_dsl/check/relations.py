@@ -161,7 +161,12 @@ class RelationProver:
     def origin_interior(self, a: Subject) -> None:
         """The origin is an interior point (stable-type properties need a neighbourhood
         of the equilibrium)."""
-        inner = L.substitute(L.open_inner(self._member(a)), {s: E.ZERO for s in self.states})
+        try:
+            inner = L.substitute(L.open_inner(self._member(a)), {s: E.ZERO for s in self.states})
+        except E.ExprError as exc:
+            self.context.error(f"{a.text} is undefined at the origin ({exc}), so it cannot "
+                               "show that the origin is stable", a.span)
+            return
         if self._query(L.negation(inner), f"the origin is an interior point of {a.text}",
                        a.span) is not None:
             self.context.error(f"{a.text} contains no neighbourhood of the origin, so it "
