@@ -708,8 +708,10 @@ dynamics continuous {
     x0' = x1 - x0^3
     x1' = u0
 }
-domain ball([0, 0], 1)
-prove stable
+domain ball([0, 0], 1) - ball([0, 0], 0.01)
+set init = ball([0.5, 0.5], 0.1)
+set unsafe = ball([-0.5, -0.5], 0.1)
+prove from init: always not unsafe
 synthesis {
     certificate: sigmoid(5), square(5)
     controller: linear(5)
