@@ -1,6 +1,7 @@
 """The Python interface; the `fossilc` command is a thin layer over these functions."""
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -60,7 +61,8 @@ def check_source(source: Source) -> CheckResult:
     except SpecError as exc:
         return CheckResult(source, None, tuple(exc.diagnostics))
     report = _check_tree(tree)
-    return CheckResult(source, report.spec, report.diagnostics)
+    spec = report.spec and dataclasses.replace(report.spec, source=source.text)
+    return CheckResult(source, spec, report.diagnostics)
 
 
 def check_text(text: str, path: str = "<string>") -> CheckResult:

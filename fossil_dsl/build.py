@@ -84,7 +84,7 @@ def build_spec(name: str, states: Sequence, dynamics: Sequence, domain: SetLike,
     report = check_tree(parse_source(source))  # a syntax error raises SpecError
     if report.spec is None or has_errors(report.diagnostics):
         raise SpecError([d for d in report.diagnostics if d.is_error], source)
-    spec = _with_bespoke_sets(report.spec, bespoke)
+    spec = dataclasses.replace(_with_bespoke_sets(report.spec, bespoke), source=text)
     if torch_dynamics is not None:
         _check_agreement(spec, torch_dynamics)
         spec = dataclasses.replace(spec, torch_dynamics=torch_dynamics)

@@ -17,13 +17,13 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir.symbolic import to_sympy
 from fossil_dsl.kernel import Claim, NoRule, Verdict, not_certified
 from fossil_dsl.kernel import list_obligations as kernel_obligations
+from fossil_dsl.kernel.export import script
 from fossil_dsl.plan import Plan
 from fossil_dsl.plot import phase_portrait
 from fossil_dsl.smt import registry
-from fossil_dsl.smt.api import UnsupportedTheory
 from fossil_dsl.smt.smtlib import query_text
 
-SCHEMA_VERSION = 2  # docs/result-schema.md; 2 added networks, versions, certificate kind
+SCHEMA_VERSION = 3  # docs/cli.md; 2 added networks, versions; 3 the kernel, spec text, ball
 
 
 @dataclass(frozen=True)
@@ -124,7 +124,8 @@ class Result:
         return {
             "schema": SCHEMA_VERSION,
             "fossil_dsl": __version__,
-            "spec": {"name": plan.spec.name, "path": plan.spec.path},
+            "spec": {"name": plan.spec.name, "path": plan.spec.path,
+                     "text": plan.spec.source},
             "property": {"form": plan.spec.property.form, "formula": plan.spec.property.text},
             "certificate": plan.certificate.title,
             "certificate_kind": type(plan.certificate).__name__,
@@ -136,6 +137,7 @@ class Result:
             "networks": {name: network_json(n, self.digits) for name, n in self.networks.items()},
             "controller": {name: str(f) for name, f in self.controller.items()},
             "levels": {name: str(v) for name, v in self.levels.items()},
+            "excluded_ball": str(plan.origin_radius),
             "learn_only": self.learn_only,
             "conditions": [_condition_json(c) for c in self.conditions],
             "kernel": kernel_json(self.kernel),
@@ -257,17 +259,7 @@ def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
         found = kernel_obligations(claim_of(plan, outcome))
     except NoRule:
         return condition_scripts(plan, outcome)
-    scripts = {}
-    for obligation in found:
-        comments = [f"{plan.spec.name}: {obligation.name}: {obligation.text}",
-                    "unsat means the obligation holds"]
-        try:
-            scripts[obligation.file_stem] = query_text(obligation.query, plan.states,
-                                                       comments=comments)
-        except UnsupportedTheory as exc:  # e.g. a power SMT-LIB cannot write
-            scripts[obligation.file_stem] = f"; {comments[0]}\n; not expressible " \
-                f"in SMT-LIB 2: {exc}\n"
-    return scripts
+    return {o.file_stem: script(o, plan.states, plan.spec.name) for o in found}
 
 
 def condition_scripts(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:

@@ -116,7 +116,7 @@ def test_run_json_is_pure_json(tmp_path):
     import json
     run = fossilc(write(tmp_path, CERTIFIABLE), "--json")
     data = json.loads(run.stdout)
-    assert data["verdict"] == "certified" and data["schema"] == 2
+    assert data["verdict"] == "certified" and data["schema"] == 3
     assert set(data["functions"]) == {"V"}
 
 

@@ -39,7 +39,7 @@ def stable_run(tmp_path_factory):
 # ---- artefacts ----------------------------------------------------------------
 def test_result_json_schema_2_has_exact_weights_and_versions(stable_run):
     data = json.loads((stable_run / "result.json").read_text())
-    assert data["schema"] == 2 and data["verdict"] == "certified"
+    assert data["schema"] == 3 and data["verdict"] == "certified"
     assert data["certificate_kind"] == "Lyapunov"
     assert {"torch", "z3-solver", "cvc5", "python"} <= set(data["versions"])
     layers = data["networks"]["V"]["layers"]
@@ -88,7 +88,29 @@ def test_recheck_fails_a_tampered_obligation(stable_run, tmp_path):
     text = re.sub(r"\(assert .*\n", "(assert (> (* x0 x0) 1.0))\n", obligation.read_text())
     obligation.write_text(text)
     run = fossilc("recheck", copy)
-    assert run.returncode == 1 and "[FAILS] condition-positive" in run.stdout
+    assert run.returncode == 1 and "[ALTERED] condition-positive" in run.stdout
+
+
+def test_recheck_derives_the_obligations_from_the_spec(stable_run, tmp_path):
+    """A run that leaves an obligation out does not pass: recheck derives the list
+    itself, from the spec's text and the formulas in result.json."""
+    copy = tmp_path / "copy"
+    subprocess.run(["cp", "-r", str(stable_run), str(copy)], check=True)
+    (copy / "obligations" / "neighbourhood.smt2").unlink()
+    run = fossilc("recheck", copy)
+    assert run.returncode == 1 and "[MISSING] neighbourhood" in run.stdout
+
+
+def test_recheck_reads_the_formulas_back_exactly(stable_run, tmp_path):
+    """Changing a formula in result.json changes the derived obligations, which then
+    differ from the exported files."""
+    copy = tmp_path / "copy"
+    subprocess.run(["cp", "-r", str(stable_run), str(copy)], check=True)
+    data = json.loads((copy / "result.json").read_text())
+    data["functions"]["V"] = "x0^2 + x1^2"
+    (copy / "result.json").write_text(json.dumps(data))
+    run = fossilc("recheck", copy)
+    assert run.returncode == 1 and "[ALTERED] condition-positive" in run.stdout
 
 
 def test_recheck_of_a_missing_folder_is_a_clear_error(tmp_path):

@@ -93,6 +93,7 @@ class CheckedSpec:
     # for specs built in Python: the field as a torch function (points, inputs) -> values,
     # used for learning only; every proof uses `dynamics`
     torch_dynamics: Callable | None = None
+    source: str = ""  # the spec's text (what `fossilc recheck` checks it again from)
 
     @property
     def has_controller(self) -> bool:
