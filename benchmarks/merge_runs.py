@@ -8,7 +8,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from fossil_dsl.bench import Run, describe, write
+from fossil_dsl.frontends.bench import Run, describe, write
 
 ROOT = Path(__file__).resolve().parent.parent
 

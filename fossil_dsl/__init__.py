@@ -9,16 +9,32 @@
     outcome.save("out"); outcome.plot("portrait.png")      # artefacts, phase portrait
     spec = fossil_dsl.build_spec(...)                      # a spec built in Python
 """
-from fossil_dsl.api import (BespokeSet, BuildError, CheckResult, build_spec, check_file,
-                            check_source, check_text, load, loads, parse, spec_text,
-                            synthesise)
-from fossil_dsl.result import Result
 from fossil_dsl.diagnostics import Diagnostic, FslError, Severity, SpecError, SpecSyntaxError
+from fossil_dsl.frontends.checking import (CheckResult, check_file, check_source, check_text,
+                                           load, loads, parse)
 from fossil_dsl.ir.spec import CheckedSpec
-
 from fossil_dsl.version import __version__
+
+# Names whose modules import torch or sympy are loaded on first use (PEP 562), so that
+# `import fossil_dsl` and `fossilc check` stay fast.
+_LAZY = {"synthesise": "fossil_dsl.frontends.api", "Result": "fossil_dsl.outputs.result",
+         "BespokeSet": "fossil_dsl.frontends.build", "BuildError": "fossil_dsl.frontends.build",
+         "build_spec": "fossil_dsl.frontends.build", "spec_text": "fossil_dsl.frontends.build"}
 
 __all__ = ["BespokeSet", "BuildError", "CheckResult", "CheckedSpec", "Result", "build_spec",
            "spec_text", "Diagnostic", "FslError", "Severity", "SpecError",
            "SpecSyntaxError", "check_file", "check_source", "check_text", "load", "loads",
            "parse", "synthesise", "__version__"]
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'fossil_dsl' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

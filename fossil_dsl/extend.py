@@ -9,7 +9,7 @@ property form) tells the compiler how to search for a certificate, and a `kernel
 tells the kernel what must be proved before the run is CERTIFIED. Nothing else changes:
 the learner gets one loss term per condition and the verifier one query per condition.
 """
-from fossil_dsl.certificates import (Certificate, Condition, LearnedFunction, Level,
+from fossil_dsl.plan.certificates import (Certificate, Condition, LearnedFunction, Level,
                                      change_of, level_of, register, value_of)
 from fossil_dsl.check.properties import PropertyForm, register_form
 from fossil_dsl.ir import expr, logic, sets

@@ -6,32 +6,27 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "fossil_dsl"
 
-# What each part of the package may import from the package (besides itself).
+# What each part of the package may import from the package (besides itself). The folders
+# are the pipeline: syntax -> check -> plan -> engine -> outputs, with the kernel apart (it
+# sees only the IR and the solvers) and the front ends on top.
 ALLOWED = {
     "version": set(),
     "diagnostics": set(),
     "ir": {"diagnostics"},
+    "solvers": {"diagnostics", "ir"},
+    # the proof kernel: the IR and the solvers only (no learner, no torch, no plan)
+    "kernel": {"ir", "solvers"},
     "syntax": {"diagnostics"},
-    "smt": {"diagnostics", "ir"},
-    "check": {"diagnostics", "ir", "syntax", "smt"},
-    "certificates": {"diagnostics", "ir"},
-    # the proof kernel: the IR and the solvers only (no learner, no torch)
-    "kernel": {"ir", "smt"},
-    "plan": {"diagnostics", "ir", "certificates", "smt", "kernel"},
-    "learn": {"ir"},
-    "cegis": {"ir", "certificates", "learn", "plan", "smt"},
-    "plot": {"diagnostics", "ir", "learn"},
-    "result": {"version", "ir", "learn", "plan", "plot", "cegis", "smt", "kernel"},
-    "recheck": {"diagnostics", "ir", "smt", "syntax", "check", "kernel"},
-    "extend": {"ir", "check", "certificates", "kernel"},
-    "build": {"diagnostics", "ir", "syntax", "check", "learn", "smt"},
-    "api": {"build", "diagnostics", "ir", "syntax", "check", "plan", "cegis", "result", "smt",
-            "kernel"},
-    "bench": {"version", "diagnostics", "api", "plan"},
-    "cli": {"version", "diagnostics", "api", "plan", "result", "smt", "bench", "recheck", "plot",
-            "yaml_import"},
-    "yaml_import": {"diagnostics", "syntax"},
+    "check": {"diagnostics", "ir", "syntax", "solvers"},
+    "plan": {"diagnostics", "ir", "solvers", "kernel"},
+    "engine": {"ir", "plan", "solvers"},
+    "outputs": {"version", "diagnostics", "ir", "syntax", "check", "plan", "engine", "solvers",
+                "kernel"},
+    "extend": {"ir", "check", "plan", "kernel"},
+    "frontends": {"version", "diagnostics", "ir", "syntax", "check", "plan", "engine",
+                  "outputs", "solvers", "kernel"},
 }
+MAX_LINES = 350
 
 
 def part_of(path: Path) -> str:
@@ -100,5 +95,96 @@ def test_kernel_imports_no_learner():
             elif isinstance(node, ast.ImportFrom) and node.module:
                 imported.add(node.module.split(".")[0])
                 imported.add(".".join(node.module.split(".")[:2]))
-        assert not imported & {"torch", "fossil_dsl.learn", "fossil_dsl.cegis",
-                               "fossil_dsl.certificates", "fossil_dsl.plan"}, path
+        assert not imported & {"torch", "fossil_dsl.engine", "fossil_dsl.plan",
+                               "fossil_dsl.outputs", "fossil_dsl.frontends"}, path
+
+
+def test_no_module_is_over_the_size_where_one_job_fits():
+    long = {str(p.relative_to(PACKAGE)): n for p in MODULES
+            if (n := len(p.read_text().splitlines())) > MAX_LINES}
+    assert not long, f"modules over {MAX_LINES} lines: {long}"
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imported_modules(path: Path, known: set[str]) -> set[str]:
+    """The package's modules that `path` imports, at any depth (a circle closed by an
+    import inside a function is still a circle)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            candidates = [f"{node.module}.{a.name}" for a in node.names] + [node.module]
+        elif isinstance(node, ast.Import):
+            candidates = [a.name for a in node.names]
+        else:
+            continue
+        found |= {c for c in candidates if c in known}
+    return found
+
+
+def import_graph() -> dict[str, set[str]]:
+    paths = {module_name(p): p for p in PACKAGE.rglob("*.py")}
+    graph = {name: imported_modules(path, set(paths)) - {name} for name, path in paths.items()}
+    # a package's __init__ importing its own modules is not a circle of jobs
+    return {name: {m for m in deps if not m.startswith(name + ".")}
+            for name, deps in graph.items()}
+
+
+def test_no_import_circles():
+    circles = [c for c in strongly_connected(import_graph()) if len(c) > 1]
+    assert not circles, f"modules importing each other: {circles}"
+
+
+def test_the_circle_finder_finds_a_circle():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
+    assert sorted(map(sorted, strongly_connected(graph))) == [["a", "b", "c"], ["d"]]
+
+
+def strongly_connected(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Tarjan's algorithm."""
+    index, low, stack, on_stack, result = {}, {}, [], set(), []
+
+    def visit(node):
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for nxt in sorted(graph.get(node, ())):
+            if nxt not in index:
+                visit(nxt)
+                low[node] = min(low[node], low[nxt])
+            elif nxt in on_stack:
+                low[node] = min(low[node], index[nxt])
+        if low[node] == index[node]:
+            component = []
+            while not component or component[-1] != node:
+                component.append(stack.pop())
+                on_stack.discard(component[-1])
+            result.append(sorted(component))
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return result
+
+
+HEAVY = ("torch", "sympy", "matplotlib", "cvc5", "codac")
+
+
+@pytest.mark.parametrize("command", [["--help"], ["--version"],
+                                     ["check", "specs/stability_continuous.fsl"],
+                                     ["check", "specs/rar_controlled.fsl"]])
+def test_commands_that_learn_nothing_import_no_heavy_library(command):
+    """`fossilc --help` and `fossilc check` run in an editor loop: no torch, sympy,
+    matplotlib, cvc5 or codac at start-up (python -X importtime lists every import)."""
+    import subprocess
+    import sys
+    run = subprocess.run([sys.executable, "-X", "importtime", "-m", "fossil_dsl.frontends.cli",
+                          *command], cwd=PACKAGE.parent, capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    imported = {line.rsplit("|", 1)[-1].strip() for line in run.stderr.splitlines()
+                if line.startswith("import time:")}
+    assert not imported & set(HEAVY), sorted(imported & set(HEAVY))

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from fossil_dsl import bench
+from fossil_dsl.frontends import bench
 
 ROOT = Path(__file__).resolve().parent.parent
 FOSSILC = Path(sys.executable).with_name("fossilc")

@@ -76,7 +76,7 @@ def test_console_examples_run_as_shown(command, output, tmp_path):
     for folder in ("specs", "benchmarks"):
         (tmp_path / folder).symlink_to(ROOT / folder)
     env = {**os.environ, "COLUMNS": "200"}
-    run = subprocess.run([sys.executable, "-m", "fossil_dsl.cli", *words[1:]], cwd=tmp_path,
+    run = subprocess.run([sys.executable, "-m", "fossil_dsl.frontends.cli", *words[1:]], cwd=tmp_path,
                          capture_output=True, text=True, timeout=600, env=env)
     printed = run.stdout + run.stderr
     text = "\n".join(output)

@@ -8,13 +8,13 @@ import pytest
 import torch
 
 import fossil_dsl
-from fossil_dsl.cegis.loop import Cegis
-from fossil_dsl.plan import compile_spec, loss_text, plan_text, symbolic_queries
+from fossil_dsl.engine.loop import Cegis
+from fossil_dsl.plan.compile import compile_spec, loss_text, plan_text, symbolic_queries
 from fossil_dsl.kernel import not_certified
-from fossil_dsl.result import build_result, write_artefacts
-from fossil_dsl.smt.api import Answer, Status
-from fossil_dsl.smt.cvc5_backend import Cvc5Backend
-from fossil_dsl.smt.z3_backend import Z3Backend
+from fossil_dsl.outputs.result import build_result, write_artefacts
+from fossil_dsl.solvers.api import Answer, Status
+from fossil_dsl.solvers.cvc5_backend import Cvc5Backend
+from fossil_dsl.solvers.z3_backend import Z3Backend
 
 ROOT = Path(__file__).resolve().parent.parent
 FOSSILC = Path(sys.executable).with_name("fossilc")
@@ -183,7 +183,7 @@ def test_discrete_time_without_a_sound_certificate_is_a_clear_error(tmp_path, pr
 
 
 def test_candidate_must_vanish_at_the_origin(tmp_path):
-    from fossil_dsl.plan import CompileError
+    from fossil_dsl.plan.compile import CompileError
     spec = spec_text(LINEAR + "synthesis { candidate: x0^2 + x1^2 + 1 }\n")
     with pytest.raises(CompileError, match=r"must be 0 at the origin, but V\(0\) = 1"):
         fossil_dsl.synthesise(spec)
@@ -198,8 +198,8 @@ def test_candidate_must_vanish_at_the_origin(tmp_path):
 def test_training_stops_when_the_exact_guard_samples_meet_the_condition():
     """A sample in the band round the guard (B slightly > 0) is trained on but need not
     meet the condition: it may be a point where no certificate can meet it."""
-    from fossil_dsl.cegis.learner import _met
-    from fossil_dsl.certificates.base import level_set
+    from fossil_dsl.engine.loss import is_met as _met
+    from fossil_dsl.plan.certificates.base import level_set
     from fossil_dsl.ir import expr as E
     from fossil_dsl.ir import logic as L
     env = {"$B": torch.tensor([-1.0, 0.05, -0.5], dtype=torch.float64)}
@@ -213,7 +213,7 @@ def test_training_stops_when_the_exact_guard_samples_meet_the_condition():
 
 
 def _lyapunov_learner(dynamics: str):
-    from fossil_dsl.cegis.learner import Learner
+    from fossil_dsl.engine.learner import Learner
     spec = spec_text(f"spec s\nstate x0, x1\ndynamics continuous {{\n{dynamics}\n}}\n"
                      "domain ball([0, 0], 1)\nprove stable\n")
     plan = compile_spec(spec)
@@ -234,7 +234,7 @@ def test_violating_samples_are_added_worst_first_and_only_those():
     """Samples that violate a condition exactly are certain counterexamples: the
     learner keeps the worst of them (by its own check, confirmed here by autograd) and
     reports when there is none."""
-    from fossil_dsl.cegis.learner import FRESH_KEPT
+    from fossil_dsl.engine.violations import FRESH_KEPT
     learner, plan = _lyapunov_learner("x0' = x0\n x1' = x1")  # V cannot decrease
     decrease = next(c for c in plan.conditions if c.name == "decrease")
     grid = torch.cartesian_prod(*[torch.linspace(-0.7, 0.7, 41, dtype=torch.float64)] * 2)
@@ -257,7 +257,7 @@ def test_violating_samples_are_added_worst_first_and_only_those():
 
 
 def test_a_run_that_brings_no_new_counterexample_is_stalled():
-    from fossil_dsl.cegis.loop import STALL_ITERATIONS, IterationRecord, Verdict, _stalled
+    from fossil_dsl.engine.loop import STALL_ITERATIONS, IterationRecord, Verdict, _stalled
 
     def record(i, *found):
         verdicts = tuple(Verdict(name, Status.SAT, "", point) for name, point in found)
@@ -289,7 +289,7 @@ def test_a_stiff_field_component_gives_the_certificate_a_scaled_input():
     """Over hi_ord_8's training samples, its last field component is about 12000 times
     the others: the barrier sees x7 / 10^4. A controlled system is judged open loop;
     row 7's fields (1.6 and 0 with u = 0) need no scaling."""
-    from fossil_dsl.cegis.learner import Learner
+    from fossil_dsl.engine.learner import Learner
     root = Path(__file__).resolve().parent.parent / "specs"
     expected = {"scaling/hi_ord_08.fsl": (1,) * 7 + (10 ** 4,),
                 "scaling/hi_ord_04.fsl": None,
@@ -320,7 +320,7 @@ def test_the_controller_is_steered_towards_the_goal_and_looks_near_it():
     """With a goal, the control loss rewards a field pointing to the goal's centre, and
     half its samples lie near the goal (its box scaled by 3): -1 exactly when the field
     points to the centre everywhere, more when it points to the origin."""
-    from fossil_dsl.cegis.learner import TARGET_SURROUNDINGS, Learner
+    from fossil_dsl.engine.learner import TARGET_SURROUNDINGS, Learner
     plan = compile_spec(spec_text(STEERED))
     assert plan.controller.target == plan.spec.property.role("goal")
     learner = Learner(plan, torch.Generator().manual_seed(0))
@@ -335,7 +335,7 @@ def test_the_controller_is_steered_towards_the_goal_and_looks_near_it():
 
 
 def test_without_a_goal_the_controller_is_steered_to_the_origin():
-    from fossil_dsl.cegis.learner import Learner
+    from fossil_dsl.engine.learner import Learner
     plan = compile_spec(spec_file("stability_controlled"))
     assert plan.controller.target is None
     learner = Learner(plan, torch.Generator().manual_seed(0))

@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import fossil_dsl
-from fossil_dsl.ir.printing import to_text
+from fossil_dsl.ir.expr import to_text
 from fossil_dsl.kernel import Claim, judge
 
 TIMEOUT = 1.0  # seconds per obligation: running out is "not proved", never a proof

@@ -39,7 +39,7 @@ from hypothesis import HealthCheck, event, given, reject, settings
 from hypothesis import strategies as st
 
 from fossil_dsl import CheckResult, CheckedSpec, Diagnostic, Severity, SpecError, check_text
-from fossil_dsl.api import check_file, check_source
+from fossil_dsl.frontends.api import check_file, check_source
 from fossil_dsl.diagnostics import Source
 from fossil_dsl.syntax.parser import decode_source
 

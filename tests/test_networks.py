@@ -6,10 +6,11 @@ import pytest
 import torch
 
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 from fossil_dsl.ir.activations import ACTIVATIONS
 from fossil_dsl.ir.spec import Layer
-from fossil_dsl.learn.evaluate import evaluate, state_env
-from fossil_dsl.learn.networks import Network, input_divisors
+from fossil_dsl.engine.evaluate import evaluate, state_env
+from fossil_dsl.engine.networks import Network, input_divisors
 
 STATES = ("x0", "x1", "x2")
 
@@ -26,7 +27,7 @@ def test_formula_equals_network(activation, zero_at_origin):
     got = torch.as_tensor(evaluate(formula, state_env(STATES, points)), dtype=torch.float64)
     assert torch.allclose(got.expand(50), expected, rtol=1e-9, atol=1e-9)
     if zero_at_origin:
-        assert E.substitute(formula, {s: E.ZERO for s in STATES}) == E.ZERO
+        assert traversal.substitute(formula, {s: E.ZERO for s in STATES}) == E.ZERO
         assert float(network(torch.zeros(1, 3, dtype=torch.float64)).detach()) == 0.0
 
 
@@ -34,7 +35,7 @@ def test_polynomial_activations_give_polynomials():
     for name, activation in ACTIVATIONS.items():
         network = Network(2, (Layer(name, 3),), zero_at_origin=True)
         formula = network.formula(("x0", "x1"), digits=3)
-        assert E.is_arithmetic(formula) == (activation.polynomial_degree is not None
+        assert traversal.is_arithmetic(formula) == (activation.polynomial_degree is not None
                                             or name == "relu")
 
 
@@ -79,7 +80,7 @@ def test_input_divisor_is_exact_in_the_formula_and_the_weights_on_x():
     assert weights[0][1] == Fraction(round(float(trained[0, 1]) * 1000), 1000) / 1000
     assert weights[0][0] == Fraction(round(float(trained[0, 0]) * 1000), 1000)
     assert "input_divisor" in network.state_dict()
-    from fossil_dsl.result import network_json
+    from fossil_dsl.outputs.result import network_json
     reported = network_json(network, 3)["layers"][0]["weight"]
     assert reported == [[str(w) for w in row] for row in weights]
 
@@ -93,7 +94,7 @@ def test_no_divisor_when_every_field_component_is_of_one_size():
 
 
 def test_climb_moves_along_a_level_set_to_the_worst_point_in_the_box():
-    from fossil_dsl.learn.ascent import climb
+    from fossil_dsl.engine.ascent import climb
 
     def objective(x):  # violation x1, on the level set x0 + x1 = 1
         return x[:, 1], x[:, 0] + x[:, 1] - 1

@@ -27,7 +27,7 @@ def test_wheel_contains_grammar_and_entry_point(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     assert "fossil_dsl/grammar/fsl.lark" in names
     entry_points = next(n for n in names if n.endswith("entry_points.txt"))
-    assert "fossilc = fossil_dsl.cli:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
+    assert "fossilc = fossil_dsl.frontends.cli:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
 
 
 def test_wheel_contains_every_module(wheel):

@@ -20,7 +20,7 @@ import fossil_dsl
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.expr import Num
 from fossil_dsl.kernel import Claim, judge
-from fossil_dsl.plan import compile_spec
+from fossil_dsl.plan.compile import compile_spec
 
 
 def check_errors(text: str) -> str:

@@ -17,7 +17,7 @@ from fossil_dsl.diagnostics import Diagnostic, Span, article, has_errors
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.spec import CheckedSpec, Property, TimeDomain
-from fossil_dsl.smt.z3_backend import Z3Backend
+from fossil_dsl.solvers.z3_backend import Z3Backend
 from fossil_dsl.syntax import ast
 
 _SINGLE = {ast.SpecDecl: "spec", ast.StateDecl: "state", ast.InputDecl: "input",

@@ -10,6 +10,7 @@ from typing import Iterable
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.diagnostics import article, did_you_mean
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 from fossil_dsl.syntax import ast
 
 MAX_DECIMAL_EXPONENT = 1000
@@ -38,8 +39,8 @@ class ExpressionChecker:
         except E.ExprError as exc:
             self.context.error(str(exc), node.span)
             return E.ZERO
-        if E.degree(value) > E.MAX_DEGREE:
-            self.context.error(f"this expression has degree up to {E.degree(value)}; at most "
+        if traversal.degree(value) > E.MAX_DEGREE:
+            self.context.error(f"this expression has degree up to {traversal.degree(value)}; at most "
                                f"{E.MAX_DEGREE} is supported (solvers stall beyond)", node.span)
             return E.ZERO
         return value

@@ -12,7 +12,7 @@ from fossil_dsl.diagnostics import Span, did_you_mean
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir.activations import ACTIVATIONS
 from fossil_dsl.ir.spec import Layer, SampleCounts, SynthesisOptions
-from fossil_dsl.smt import registry
+from fossil_dsl.solvers import registry
 from fossil_dsl.syntax import ast
 
 MAX_WIDTH = 10_000

@@ -16,12 +16,14 @@ from typing import Sequence
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.diagnostics import Span
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.enclosure import sign
-from fossil_dsl.ir.printing import number_text, to_text
-from fossil_dsl.smt import registry
-from fossil_dsl.smt.api import Answer, Backend, Status
+from fossil_dsl.ir.expr import to_text
+from fossil_dsl.ir.numbers import number_text
+from fossil_dsl.solvers import registry
+from fossil_dsl.solvers.api import Answer, Backend, Status
 
 RELATION_TIMEOUT = 2.5  # seconds per query
 RELATION_BUDGET = 5.0  # seconds for all of a spec's queries: checking is never slow
@@ -193,7 +195,7 @@ def check_equilibrium(context: CheckContext, states: Sequence[str], inputs: Sequ
     for state, value, span in zip(states, dynamics, spans):
         lhs = f"next({state})" if discrete else f"{state}'"
         try:
-            at_origin = E.substitute(value, zeros)
+            at_origin = traversal.substitute(value, zeros)
         except E.ExprError as exc:
             context.error(f"{lhs} = {to_text(value)} is undefined at the origin ({exc})", span)
             continue

@@ -4,6 +4,7 @@ from __future__ import annotations
 from typing import Mapping, Sequence
 
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 
 TWO = E.Num(2)
 
@@ -87,4 +88,4 @@ def lie_derivative(expr: E.Expr, variables: Sequence[str],
 def compose(expr: E.Expr, variables: Sequence[str], images: Sequence[E.Expr]) -> E.Expr:
     """expr with each variable replaced by its image: V(f(x))."""
     mapping: Mapping[str, E.Expr] = dict(zip(variables, images))
-    return E.substitute(expr, mapping)
+    return traversal.substitute(expr, mapping)

@@ -20,6 +20,7 @@ from fractions import Fraction
 
 from fossil_dsl.ir import expr as E
 
+
 @functools.cache
 def _libm():
     path = ctypes.util.find_library("m")
@@ -51,22 +52,27 @@ def upward_rounding():
         libm.fesetround(previous)
 
 
-def rational_interval(value: Fraction):
-    """The smallest double interval containing an exact rational (call under
-    upward_rounding)."""
-    codac = _codac()[0]
+def rational_bounds(value: Fraction) -> tuple[float, float]:
+    """The nearest doubles below and above an exact rational (compared exactly)."""
     if abs(value) >= Fraction(10) ** 300:
-        low, high = (-math.inf, -1e300) if value < 0 else (1e300, math.inf)
-        return codac.Interval(low, high)
+        return (-math.inf, -1e300) if value < 0 else (1e300, math.inf)
     near = float(value)
     low = near if Fraction(near) <= value else math.nextafter(near, -math.inf)
     high = near if Fraction(near) >= value else math.nextafter(near, math.inf)
-    return codac.Interval(low, high)
+    return low, high
+
+
+def rational_interval(value: Fraction):
+    """The smallest double interval containing an exact rational (call under
+    upward_rounding)."""
+    return _codac()[0].Interval(*rational_bounds(value))
 
 
 def enclose(expr: E.Expr) -> tuple[float, float]:
     """(low, high) floats containing the exact value of a variable-free expression;
     low > high means the value is undefined (e.g. log of a negative number)."""
+    if isinstance(expr, E.Num):  # no interval arithmetic needed (nor codac's import)
+        return rational_bounds(expr.value)
     with upward_rounding():
         interval = _enclose(expr)
         if interval.is_empty():

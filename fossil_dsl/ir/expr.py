@@ -7,8 +7,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Callable, Mapping
 
+from fossil_dsl.ir.functions import FUNCTIONS, DomainError
+from fossil_dsl.ir.numbers import number_text
+
+_SUM, _PRODUCT, _UNARY, _POWER, _ATOM = range(5)  # binding, loosest first
 MAX_CONSTANT_BITS = 4_000  # about 1e1200; beyond it constants are rejected, not computed
 
 
@@ -31,7 +34,6 @@ class Expr:
     def __neg__(self): return neg(self)
 
     def __str__(self) -> str:
-        from fossil_dsl.ir.printing import to_text
         return to_text(self)
 
 
@@ -221,64 +223,17 @@ def _fold_power(base: Fraction, n: int) -> Num:
 
 
 def apply(func: str, arg: Expr) -> Expr:
-    exact = FUNCTIONS[func].exact(arg)
-    return exact if exact is not None else Apply(func, arg)
+    if isinstance(arg, Num):
+        try:
+            value = FUNCTIONS[func].exact(arg.value)
+        except DomainError as error:
+            raise ExprError(str(error)) from None
+        if value is not None:
+            return Num(value)
+    return Apply(func, arg)
 
 
-# ---- the functions of the language ----------------------------------------------
-@dataclass(frozen=True)
-class Function:
-    """A function the language allows; `exact` folds it where the value is rational."""
-
-    name: str
-    exact: Callable[[Expr], Expr | None]
-    piecewise_linear: bool = False  # abs: expressible in linear arithmetic with ite
-
-
-def _at_zero(value: int) -> Callable[[Expr], Expr | None]:
-    return lambda arg: Num(Fraction(value)) if is_num(arg, 0) else None
-
-
-def _exact_log(arg: Expr) -> Expr | None:
-    if is_num(arg) and arg.value <= 0:
-        raise ExprError("log of a non-positive number")
-    return ZERO if is_num(arg, 1) else None
-
-
-def _exact_sqrt(arg: Expr) -> Expr | None:
-    if not isinstance(arg, Num):
-        return None
-    if arg.value < 0:
-        raise ExprError("sqrt of a negative number")
-    num, den = arg.value.numerator, arg.value.denominator
-    root_n, root_d = _isqrt_exact(num), _isqrt_exact(den)
-    return Num(Fraction(root_n, root_d)) if root_n is not None and root_d is not None else None
-
-
-def _isqrt_exact(n: int) -> int | None:
-    import math
-    root = math.isqrt(n)
-    return root if root * root == n else None
-
-
-def _exact_abs(arg: Expr) -> Expr | None:
-    return Num(abs(arg.value)) if isinstance(arg, Num) else None
-
-
-FUNCTIONS: Mapping[str, Function] = {f.name: f for f in (
-    Function("sin", _at_zero(0)),
-    Function("cos", _at_zero(1)),
-    Function("tan", _at_zero(0)),
-    Function("exp", _at_zero(1)),
-    Function("log", _exact_log),
-    Function("sqrt", _exact_sqrt),
-    Function("tanh", _at_zero(0)),
-    Function("atan", _at_zero(0)),
-    Function("abs", _exact_abs, piecewise_linear=True),
-)}
-
-
-# ---- traversal ------------------------------------------------------------------
+# ---- the tree -----------------------------------------------------------------
 def children(expr: Expr) -> tuple[Expr, ...]:
     if isinstance(expr, Add):
         return expr.terms
@@ -308,76 +263,50 @@ def free_vars(expr: Expr) -> frozenset[str]:
     return frozenset(node.name for node in walk(expr) if isinstance(node, Var))
 
 
-def substitute(expr: Expr, mapping: Mapping[str, Expr]) -> Expr:
-    """Replace variables by expressions, folding constants on the way up."""
+# ---- text, in the .fsl expression syntax ------------------------------------
+def to_text(expr: Expr) -> str:
+    return _text(expr)[0]
+
+
+def _text(expr: Expr) -> tuple[str, int]:
+    if isinstance(expr, Num):
+        text = number_text(expr.value)
+        return text, (_ATOM if expr.value >= 0 and "/" not in text else _UNARY)
     if isinstance(expr, Var):
-        return mapping.get(expr.name, expr)
-    if isinstance(expr, (Num, Pi)):
-        return expr
-    return rebuild(expr, tuple(substitute(child, mapping) for child in children(expr)))
-
-
-def rebuild(expr: Expr, new_children: tuple[Expr, ...]) -> Expr:
-    """The same node over new children, through the folding constructors."""
-    if isinstance(expr, Add):
-        return add(*new_children)
-    if isinstance(expr, Mul):
-        return mul(*new_children)
-    if isinstance(expr, Div):
-        return div(*new_children)
-    if isinstance(expr, Pow):
-        return power(*new_children)
-    if isinstance(expr, Neg):
-        return neg(new_children[0])
+        return expr.name, _ATOM
+    if isinstance(expr, Pi):
+        return "pi", _ATOM
     if isinstance(expr, Apply):
-        return apply(expr.func, new_children[0])
-    return expr
-
-
-def degree(expr: Expr) -> int:
-    """An upper bound on the polynomial degree (a function of a state counts as 1)."""
-    if not free_vars(expr):
-        return 0
-    if isinstance(expr, Var):
-        return 1
-    if isinstance(expr, Add):
-        return max(map(degree, expr.terms))
-    if isinstance(expr, Mul):
-        return sum(map(degree, expr.factors))
-    if isinstance(expr, Div):
-        return degree(expr.numerator) + degree(expr.denominator)
+        return f"{expr.func}({to_text(expr.arg)})", _ATOM
     if isinstance(expr, Neg):
-        return degree(expr.operand)
-    if isinstance(expr, Pow) and isinstance(expr.exponent, Num):
-        return degree(expr.base) * abs(int(expr.exponent.value))
-    if isinstance(expr, Apply) and FUNCTIONS[expr.func].piecewise_linear:
-        return degree(expr.arg)  # solvers encode abs(p) with p itself
-    return 1
+        return "-" + _wrap(expr.operand, _UNARY), _UNARY
+    if isinstance(expr, Pow):
+        return f"{_wrap(expr.base, _ATOM)}^{_wrap(expr.exponent, _ATOM)}", _POWER
+    if isinstance(expr, Div):
+        return f"{_wrap(expr.numerator, _PRODUCT)}/{_wrap(expr.denominator, _POWER)}", _PRODUCT
+    if isinstance(expr, Mul):
+        return "*".join(_wrap(f, _PRODUCT) for f in expr.factors), _PRODUCT
+    if isinstance(expr, Add):
+        return _sum_text(expr.terms), _SUM
+    raise TypeError(f"not an expression: {expr!r}")
 
 
-def is_polynomial(expr: Expr) -> bool:
-    """+, -, * and non-negative integer powers only, over rational constants."""
-    for node in walk(expr):
-        if isinstance(node, (Apply, Pi, Div)):
-            return False
-        if isinstance(node, Pow) and not _natural_exponent(node.exponent):
-            return False
-    return True
+def _sum_text(terms) -> str:
+    parts = [_wrap(terms[0], _SUM)]
+    for term in terms[1:]:
+        if isinstance(term, Neg):
+            parts.append(" - " + _wrap(term.operand, _PRODUCT))
+        elif isinstance(term, Num) and term.value < 0:
+            parts.append(" - " + number_text(-term.value))
+        elif isinstance(term, Mul) and isinstance(term.factors[0], Num) \
+                and term.factors[0].value < 0:
+            parts.append(" - " + _wrap(mul(Num(-term.factors[0].value),
+                                             *term.factors[1:]), _PRODUCT))
+        else:
+            parts.append(" + " + _wrap(term, _PRODUCT))
+    return "".join(parts)
 
 
-def is_arithmetic(expr: Expr) -> bool:
-    """Decidable by nonlinear real arithmetic: polynomials, division, integer powers, abs."""
-    for node in walk(expr):
-        if isinstance(node, Pi):
-            return False
-        if isinstance(node, Apply) and not FUNCTIONS[node.func].piecewise_linear:
-            return False
-        if isinstance(node, Pow) and not (isinstance(node.exponent, Num)
-                                          and node.exponent.value.denominator == 1):
-            return False
-    return True
-
-
-def _natural_exponent(exponent: Expr) -> bool:
-    return isinstance(exponent, Num) and exponent.value.denominator == 1 \
-        and exponent.value >= 0
+def _wrap(expr: Expr, level: int) -> str:
+    text, own = _text(expr)
+    return text if own >= level else f"({text})"

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fossil_dsl.ir.expr import Expr, free_vars as expr_free_vars, substitute as expr_substitute
+from fossil_dsl.ir.expr import Expr, Num, to_text
+from fossil_dsl.ir.traversal import free_vars as expr_free_vars, substitute as expr_substitute
 
 class Formula:
     def __and__(self, other): return conjunction(self, other)
@@ -11,7 +12,6 @@ class Formula:
     def __invert__(self): return negation(self)
 
     def __str__(self) -> str:
-        from fossil_dsl.ir.printing import formula_text
         return formula_text(self)
 
 
@@ -123,7 +123,6 @@ def _approximate(formula: Formula, same: dict, dual: dict) -> Formula:
 
 def truth(formula: Formula) -> bool | None:
     """The exact truth value of a formula whose comparisons are between numbers."""
-    from fossil_dsl.ir.expr import Num
     if isinstance(formula, BoolConst):
         return formula.value
     if isinstance(formula, Compare):
@@ -188,3 +187,23 @@ def boundary_outer(formula: Formula) -> Formula:
                                              Compare(">=", left, right))
                                  for left, right in atoms))
     return conjunction(closed_outer(formula), on_some_atom)
+
+
+# ---- text ---------------------------------------------------------------------
+def formula_text(formula: Formula) -> str:
+    if isinstance(formula, Compare):
+        return f"{to_text(formula.left)} {formula.relation} {to_text(formula.right)}"
+    if isinstance(formula, And):
+        return " and ".join(_formula_wrapped(a) for a in formula.args)
+    if isinstance(formula, Or):
+        return " or ".join(_formula_wrapped(a) for a in formula.args)
+    if isinstance(formula, Not):
+        return "not " + _formula_wrapped(formula.arg)
+    if isinstance(formula, BoolConst):
+        return "true" if formula.value else "false"
+    raise TypeError(f"not a formula: {formula!r}")
+
+
+def _formula_wrapped(formula: Formula) -> str:
+    text = formula_text(formula)
+    return f"({text})" if isinstance(formula, (And, Or)) else text

@@ -13,7 +13,7 @@ from typing import Callable, ClassVar, Sequence
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import enclose, sign
 from fossil_dsl.ir.expr import Expr, Var, add, mul, power, div, Num, free_vars
-from fossil_dsl.ir.printing import to_text
+from fossil_dsl.ir.expr import to_text
 
 Point = Sequence[Expr]
 

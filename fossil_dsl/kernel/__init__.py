@@ -5,9 +5,9 @@ obligation the guarantee rests on (`obligations.py`, `rules.py`, `definedness.py
 discharges each with a sound procedure (`prove.py`) and returns the verdict
 (`verdict.py`). It imports the IR and the solvers only: no torch, no learner.
 """
-from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation
+from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation, guarantee_text
 from fossil_dsl.kernel.prove import Outcome, Proof
 from fossil_dsl.kernel.verdict import Verdict, judge, list_obligations, not_certified
 
-__all__ = ["Claim", "NoRule", "Obligation", "Outcome", "Proof", "Verdict", "judge",
-           "list_obligations", "not_certified"]
+__all__ = ["Claim", "NoRule", "Obligation", "Outcome", "Proof", "Verdict", "guarantee_text",
+           "judge", "list_obligations", "not_certified"]

@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import Sequence
 
 from fossil_dsl.kernel.obligations import Obligation
-from fossil_dsl.smt.api import UnsupportedTheory
-from fossil_dsl.smt.smtlib import query_text
+from fossil_dsl.solvers.api import UnsupportedTheory
+from fossil_dsl.solvers.smtlib import query_text
 
 
 def script(obligation: Obligation, states: Sequence[str], spec_name: str) -> str:

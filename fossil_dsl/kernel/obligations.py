@@ -16,6 +16,7 @@ from typing import Callable, Mapping
 
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.spec import CheckedSpec, TimeDomain
@@ -30,13 +31,16 @@ BALL_ROOM = 10  # the excluded ball's radius times this must still fit in D
 class Claim:
     """What the engine proposes: exact functions ("V", "B"), the controller (input ->
     formula), the levels ("beta") and the radius of the ball a delta-decision verifier
-    left out round the origin (0: only the origin itself)."""
+    left out round the origin (0: only the origin itself). `procedures` names, per
+    condition, the procedure that proved it during the run: the kernel tries it first,
+    which changes only how soon it answers, never what it accepts."""
 
     spec: CheckedSpec
     functions: Mapping[str, E.Expr]
     controller: Mapping[str, E.Expr] = field(default_factory=dict)
     levels: Mapping[str, Fraction] = field(default_factory=dict)
     ball_radius: Fraction = Fraction(0)
+    procedures: Mapping[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -68,10 +72,11 @@ class Facts:
         self.claim = claim
         self.states = spec.states
         self.x = [E.Var(s) for s in self.states]
-        self.field = tuple(E.substitute(f, dict(claim.controller)) for f in spec.dynamics)
+        self.field = tuple(traversal.substitute(f, dict(claim.controller)) for f in spec.dynamics)
         self.discrete = spec.time is TimeDomain.DISCRETE
         self.r = claim.ball_radius
         self.obligations: list[Obligation] = []
+        self.ball_left_out = False  # some obligation excludes the ball |x| <= r
 
     # ---- sets and functions ----
     def role(self, name: str) -> S.SetExpr:
@@ -114,6 +119,7 @@ class Facts:
 
     def away_from_origin(self) -> L.Formula:
         """x outside the excluded ball (or x != 0)."""
+        self.ball_left_out = self.ball_left_out or self.r > 0
         return L.Compare(">", self.squared_norm(), E.Num(self.r ** 2))
 
     def ball(self, radius: Fraction) -> L.Formula:
@@ -169,25 +175,54 @@ def _expressions(formula: L.Formula):
 
 
 RULES: dict[tuple[str, TimeDomain], Callable[[Facts], None]] = {}
+# What the rule's obligations prove, in words: a text, or a function of "discrete".
+GUARANTEES: dict[tuple[str, TimeDomain], str | Callable[[bool], str]] = {}
 
 
-def rule(form: str, *times: TimeDomain):
+def rule(form: str, *times: TimeDomain, guarantee: str | Callable[[bool], str]):
+    """Register a rule, and the guarantee that its obligations, once proved, give."""
     def register(function):
         for time in times or (TimeDomain.CONTINUOUS,):
             RULES[(form, time)] = function
+            GUARANTEES[(form, time)] = guarantee
         return function
     return register
 
 
+def guarantee_text(spec: CheckedSpec, ball_radius: Fraction, controlled: bool) -> str:
+    """What a certified claim guarantees, in words: the rule's guarantee, weakened where
+    a ball round the origin was left out, and said of the closed loop where there is a
+    controller."""
+    key = (spec.property.form, spec.time)
+    if key not in GUARANTEES:
+        raise NoRule(f"no sound rule for {key[0]} in {key[1].value} time")
+    text = GUARANTEES[key]
+    text = text if isinstance(text, str) else text(spec.time is TimeDomain.DISCRETE)
+    if ball_radius > 0:
+        r = E.Num(ball_radius)
+        text = (f"ε-stability for ε = {r}: the conditions that exclude the origin were "
+                f"proved outside the ball |x| <= {r} only, so trajectories reach, and stay "
+                "in, the smallest sublevel set of V that contains that ball, rather than "
+                f"converging to the origin itself. Apart from that ball: {text}")
+    return text + (" (for the closed loop with the controller shown)" if controlled else "")
+
+
 def derive(claim: Claim) -> list[Obligation]:
     """The complete list of obligations for the claim's property; NoRule if none is sound."""
+    return derive_facts(claim)[0]
+
+
+def derive_facts(claim: Claim) -> tuple[list[Obligation], str]:
+    """The obligations, and the guarantee they give once proved."""
     facts = Facts(claim)
     key = (claim.spec.property.form, claim.spec.time)
     if key not in RULES:
         raise NoRule(f"no sound rule for {key[0]} in {key[1].value} time")
     common(facts)
     RULES[key](facts)
-    return _unique(facts.obligations)
+    guarantee = guarantee_text(claim.spec, claim.ball_radius if facts.ball_left_out else 0,
+                               bool(claim.controller))
+    return _unique(facts.obligations), guarantee
 
 
 def _unique(obligations: list[Obligation]) -> list[Obligation]:

@@ -2,9 +2,12 @@
 
 - A query whose comparisons are between numbers is decided by exact rational arithmetic.
 - Arithmetic queries (polynomials, division, integer powers, abs) go to Z3 on exact
-  rationals, then CVC5 if Z3 does not answer. Irrational constants (pi, sqrt(2)) are
-  replaced by variables bounded by an outward-rounded enclosure, so an UNSAT holds for
-  the true constant too.
+  rationals, then to the interval procedure, then to CVC5, each with a share of the time
+  (a hard nonlinear query can stall Z3 and CVC5 for minutes where the interval
+  procedure refutes it in seconds; a `first` procedure, the one that proved the
+  condition during the run, goes first: only the order changes). Irrational constants
+  (pi, sqrt(2)) are replaced by variables bounded by an outward-rounded enclosure, so an
+  UNSAT holds for the true constant too.
 - Other queries go to the interval procedure (codac contractors and bisection on
   outward-rounded arithmetic, every elementary function checked against mpmath by the
   tests). Only its UNSAT is used; a box it cannot refute is "not proved", never a proof.
@@ -20,9 +23,10 @@ from fractions import Fraction
 from typing import Sequence
 
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel.obligations import Obligation
-from fossil_dsl.smt.api import Answer, Status
+from fossil_dsl.solvers.api import Answer, Status
 
 
 class Outcome(Enum):
@@ -45,39 +49,55 @@ class Proof:
 
 
 def is_arithmetic(formula: L.Formula) -> bool:
-    return all(E.is_arithmetic(side) for c in L.comparisons(formula)
+    return all(traversal.is_arithmetic(side) for c in L.comparisons(formula)
                for side in (c.left, c.right))
 
 
+# Shares of an arithmetic obligation's time: Z3, the interval procedure, CVC5.
+SHARES = {"z3": 0.3, "interval": 0.5, "cvc5": 0.2}
+
+
 def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
-              delta: float | None = None) -> Proof:
+              delta: float | None = None, first: str = "") -> Proof:
     query = obligation.query
     exact = L.truth(query)
     if exact is not None:
         outcome = Outcome.FAILS if exact else Outcome.PROVED
         return Proof(obligation, outcome, "exact arithmetic")
     if is_arithmetic(query):
-        return _complete(obligation, states, timeout)
+        return _arithmetic(obligation, states, timeout, delta, first)
     return _interval(obligation, states, timeout, delta)
 
 
-def _complete(obligation: Obligation, states, timeout: float) -> Proof:
-    from fossil_dsl.smt.cvc5_backend import Cvc5Backend
-    from fossil_dsl.smt.z3_backend import Z3Backend
+def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str) -> Proof:
+    order = sorted(SHARES, key=lambda name: name != first)
     reasons = []
-    for backend in (Z3Backend(), Cvc5Backend()):
-        answer = backend.check(obligation.query, states, timeout)
+    for name in order:
+        budget = max(1.0, SHARES[name] * timeout)
+        if name == "interval":
+            proof = _interval(obligation, states, budget, delta)
+            if proof.proved:
+                return proof
+            reasons.append(f"interval: {proof.detail}")
+            continue
+        answer = _solver(name).check(obligation.query, states, budget)
         if answer.status is Status.UNSAT:
-            return Proof(obligation, Outcome.PROVED, backend.name)
+            return Proof(obligation, Outcome.PROVED, name)
         if answer.status is Status.SAT and not answer.approximate:
-            return Proof(obligation, Outcome.FAILS, backend.name, "counterexample",
+            return Proof(obligation, Outcome.FAILS, name, "counterexample",
                          _point(answer, states))
-        reasons.append(f"{backend.name}: {_reason(answer)}")
-    return Proof(obligation, Outcome.NOT_PROVED, "z3, cvc5", "; ".join(reasons))
+        reasons.append(f"{name}: {_reason(answer)}")
+    return Proof(obligation, Outcome.NOT_PROVED, ", ".join(order), "; ".join(reasons))
+
+
+def _solver(name: str):
+    from fossil_dsl.solvers.cvc5_backend import Cvc5Backend
+    from fossil_dsl.solvers.z3_backend import Z3Backend
+    return {"z3": Z3Backend, "cvc5": Cvc5Backend}[name]()
 
 
 def _interval(obligation: Obligation, states, timeout: float, delta) -> Proof:
-    from fossil_dsl.smt.interval_backend import IntervalBackend
+    from fossil_dsl.solvers.interval_backend import IntervalBackend
     backend = IntervalBackend(delta) if delta else IntervalBackend()
     answer = backend.check(obligation.query, states, timeout)
     if answer.status is Status.UNSAT:

@@ -6,6 +6,7 @@ by `Facts.never` itself.
 from __future__ import annotations
 
 from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.kernel.obligations import BALL_ROOM, GAMMA, Facts, Obligation, rule
@@ -31,7 +32,7 @@ def equilibrium(facts: Facts, function: str) -> None:
     named.append((f"{function}(0) = 0", f"origin:{function}", facts.value(function)))
     for text, name, expression in named:
         try:
-            query = nonzero(E.substitute(expression, origin))
+            query = nonzero(traversal.substitute(expression, origin))
         except E.ExprError as exc:  # undefined at the origin: the fact fails
             text, query = f"{text}; but it is undefined there ({exc})", L.TRUE
         facts.obligations.append(Obligation(name, text, query))
@@ -69,7 +70,34 @@ def lyapunov_conditions(facts: Facts, region: L.Formula, words: str) -> None:
                 away, compare("<", dV))
 
 
-@rule("stability", CONTINUOUS, DISCRETE)
+def stability_guarantee(discrete: bool) -> str:
+    step = "every step" if discrete else "along every trajectory"
+    return ("the origin is asymptotically stable: V is positive away from the origin "
+            f"and strictly decreases {step} in the domain, so trajectories that remain in "
+            "the domain converge to the origin (V(0) = 0)")
+
+
+ROA_GUARANTEE = (
+    "every trajectory from I stays in Ω = {x in D : V(x) <= β} and converges to the "
+    "origin: V <= β on I and V > β on the boundary of D, so Ω cannot be left, and V is "
+    "positive and strictly decreasing on Ω away from the origin (V(0) = 0)")
+
+
+def reach_guarantee(safe_words: str, goal_words: str) -> str:
+    return (f"every trajectory from I reaches {goal_words} in finite time and stays in "
+            f"{safe_words} until then: V <= 0 on I, V > 0 on the boundary of {safe_words}, "
+            f"and V decreases at rate at least {GAMMA} wherever V <= 0 in {safe_words} "
+            f"outside {goal_words} ({safe_words} is bounded, so V cannot decrease forever)")
+
+
+def safety_guarantee(discrete: bool) -> str:
+    return ("trajectories from I never enter U while they remain in D: B <= 0 on I, "
+            "B > 0 on U, and the zero level set of B cannot be crossed outwards "
+            + ("(the set {B <= 0} is mapped into itself)" if discrete
+               else "(B strictly decreases wherever B = 0)"))
+
+
+@rule("stability", CONTINUOUS, DISCRETE, guarantee=stability_guarantee)
 def stability(facts: Facts) -> None:
     equilibrium(facts, "V")
     neighbourhood(facts)
@@ -97,7 +125,7 @@ def region_of_attraction(facts: Facts) -> None:
                     compare("<", V, beta))
 
 
-rule("region of attraction")(region_of_attraction)
+rule("region of attraction", guarantee=ROA_GUARANTEE)(region_of_attraction)
 
 
 def barrier_conditions(facts: Facts, name: str, inside: L.Formula, outside: L.Formula,
@@ -118,7 +146,7 @@ def barrier_conditions(facts: Facts, name: str, inside: L.Formula, outside: L.Fo
                     f"{name}(x) = 0", level, compare("<", dB))
 
 
-@rule("safety", CONTINUOUS, DISCRETE)
+@rule("safety", CONTINUOUS, DISCRETE, guarantee=safety_guarantee)
 def safety(facts: Facts) -> None:
     initial, unsafe = facts.member(facts.role("initial")), facts.member(facts.role("unsafe"))
     facts.inside("relation:initial in domain", "I lies in D", initial,
@@ -127,7 +155,8 @@ def safety(facts: Facts) -> None:
     barrier_conditions(facts, "B", initial, unsafe, "I", "U")
 
 
-@rule("stable while avoid")
+@rule("stable while avoid", guarantee=ROA_GUARANTEE + "; and those trajectories never "
+      "enter U: B <= 0 on I, B > 0 on U, and B strictly decreases wherever B = 0 in D")
 def stable_while_avoid(facts: Facts) -> None:
     region_of_attraction(facts)
     initial, unsafe = facts.member(facts.role("initial")), facts.member(facts.role("unsafe"))
@@ -154,17 +183,21 @@ def reach_while_avoid(facts: Facts, goal_role: str) -> None:
                 compare("<=", dV, E.Num(-GAMMA)))
 
 
-@rule("reach while avoid")
+@rule("reach while avoid", guarantee=reach_guarantee("S", "G"))
 def reach(facts: Facts) -> None:
     reach_while_avoid(facts, "goal")
     facts.inside("relation:goal in interior of safe", "G lies in the interior of S",
                  facts.member(facts.role("goal")), facts.interior(facts.role("safe")))
 
 
-rule("reach")(reach)  # the checker makes the safe set the domain
+rule("reach", guarantee=reach_guarantee("D", "G"))(reach)  # the checker makes the safe set the domain
 
 
-@rule("reach and stay while avoid")
+@rule("reach and stay while avoid", guarantee=(
+    "every trajectory from I stays in S, reaches F ∩ {V < β} in finite time and then stays "
+    "in F for ever: V <= 0 on I and V > 0 on ∂S, V decreases at rate at least "
+    f"{GAMMA} wherever V <= 0 in S outside F ∩ {{V < β}}, and F ∩ {{V < β}} cannot be "
+    "left, since V > β on ∂F and V decreases where V = β in F"))
 def reach_and_stay(facts: Facts) -> None:
     reach_while_avoid(facts, "final")
     V, dV, beta = facts.value("V"), facts.change("V"), facts.level("beta")
@@ -178,7 +211,9 @@ def reach_and_stay(facts: Facts) -> None:
                 compare("<=", dV, E.Num(-GAMMA)))
 
 
-@rule("reach-avoid-remain")
+@rule("reach-avoid-remain", guarantee=reach_guarantee("S", "G") + (
+    "; once in G, it remains in F while it stays in D: B <= 0 on G, B > 0 on D \\ F, and "
+    "B strictly decreases wherever B = 0"))
 def reach_avoid_remain(facts: Facts) -> None:
     reach(facts)
     goal, final = facts.member(facts.role("goal")), facts.member(facts.role("final"))

@@ -10,7 +10,7 @@ import time
 from dataclasses import dataclass, field
 
 from fossil_dsl.kernel import rules  # noqa: F401  (registers the rules)
-from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation, derive
+from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation, derive, derive_facts
 from fossil_dsl.kernel.prove import Outcome, Proof, discharge
 
 _SEAL = object()
@@ -23,6 +23,7 @@ class Verdict:
     reason: str
     proofs: tuple[Proof, ...] = ()
     seconds: float = 0.0
+    guarantee: str = "nothing is proved"  # in words, from the rule; only when certified
     _seal: object = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
@@ -48,18 +49,19 @@ def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
     """Prove every obligation; stop at the first that is not proved."""
     started = time.monotonic()
     try:
-        found = derive(claim)
+        found, guarantee = derive_facts(claim)
     except NoRule as exc:
         return not_certified(f"the kernel cannot judge this claim: {exc}")
     proofs = []
     for obligation in found:
-        proof = discharge(obligation, claim.spec.states, timeout, delta)
+        first = claim.procedures.get(obligation.name.removeprefix("condition:"), "")
+        proof = discharge(obligation, claim.spec.states, timeout, delta, first)
         proofs.append(proof)
         if not proof.proved:
             return Verdict(False, _failure_text(proof), tuple(proofs),
                            time.monotonic() - started)
     return Verdict(True, f"all {len(proofs)} obligations proved", tuple(proofs),
-                   time.monotonic() - started, _SEAL)
+                   time.monotonic() - started, guarantee, _SEAL)
 
 
 def _failure_text(proof: Proof) -> str:

@@ -1,0 +1,120 @@
+"""Samples of sets: uniform in a bounding box, kept where the exact membership formula
+holds (evaluated numerically)."""
+from __future__ import annotations
+
+import math
+
+from typing import Sequence
+
+import torch
+
+from fossil_dsl.ir.sets import Boundary, SetExpr
+from fossil_dsl.engine.evaluate import holds, state_env
+
+MAX_ROUNDS = 50
+BISECTION_STEPS = 40
+
+
+def sample(region: SetExpr, states: Sequence[str], count: int, generator: torch.Generator,
+           fallback_box=None) -> torch.Tensor:
+    """Up to `count` points of `region` (fewer if the set is very thin in its box)."""
+    if isinstance(region, Boundary):
+        return _boundary(region.inner, states, count, generator, fallback_box)
+    own = region.own_samples(count, generator)
+    if own is not None:
+        return torch.as_tensor(own, dtype=torch.float64).reshape(-1, len(states))[:count]
+    box = region.bounding_box() or fallback_box
+    if box is None:
+        raise ValueError(f"cannot sample {region}: no bounding box")
+    low = torch.tensor(box[0], dtype=torch.float64)
+    high = torch.tensor(box[1], dtype=torch.float64)
+    formula = region.contains_formula(states)
+    found: list[torch.Tensor] = []
+    total = 0
+    for _ in range(MAX_ROUNDS):
+        batch = low + (high - low) * torch.rand(max(count, 64) * 2, len(states),
+                                                generator=generator, dtype=torch.float64)
+        inside = batch[holds(formula, state_env(states, batch), len(batch))]
+        found.append(inside)
+        total += len(inside)
+        if total >= count:
+            break
+    return torch.cat(found)[:count]
+
+
+def around(points: torch.Tensor, region: SetExpr, states: Sequence[str], count: int,
+           radius: float, generator: torch.Generator, box=None) -> torch.Tensor:
+    """The points plus `count` random neighbours of each that lie in `region`. A
+    neighbour that leaves the region's box (or `box`) through a face is reflected back
+    through it: at a corner of a box in n dimensions, a 2^-n share of neighbours would
+    otherwise survive, and verifiers often answer with such corners."""
+    if count == 0 or len(points) == 0:
+        return points
+    noise = torch.randn(len(points) * count, points.shape[1], generator=generator,
+                        dtype=torch.float64) * radius
+    neighbours = points.repeat_interleave(count, 0) + noise
+    box = region.bounding_box() or box
+    if box is not None:
+        neighbours = _reflect_into(neighbours, box)
+    keep = holds(region.contains_formula(states), state_env(states, neighbours),
+                 len(neighbours))
+    return torch.cat([points, neighbours[keep]])
+
+
+def _reflect_into(points: torch.Tensor, box) -> torch.Tensor:
+    low = torch.tensor(box[0], dtype=torch.float64)
+    high = torch.tensor(box[1], dtype=torch.float64)
+    points = torch.where(points < low, 2 * low - points, points)
+    points = torch.where(points > high, 2 * high - points, points)
+    return torch.minimum(torch.maximum(points, low), high)
+
+
+def _boundary(inner: SetExpr, states, count: int, generator, fallback_box) -> torch.Tensor:
+    """Points within ~1e-12 of the boundary of `inner`: bisect segments from a point of
+    the set to a point outside it (in its box grown by a fifth). Any set shape works; the
+    verifier, not these points, decides the condition on the exact boundary."""
+    box = inner.bounding_box() or fallback_box
+    if box is None:
+        raise ValueError(f"cannot sample the boundary of {inner}: no bounding box")
+    low = torch.tensor(box[0], dtype=torch.float64)
+    high = torch.tensor(box[1], dtype=torch.float64)
+    grow = 0.2 * (high - low) + 1e-3
+    formula = inner.contains_formula(states)
+    inside = sample(inner, states, count, generator, fallback_box)
+    if len(inside) == 0:
+        return inside
+    outside = sample_outside(formula, states, low - grow, high + grow, len(inside), generator)
+    if len(outside) == 0:
+        return outside
+    a, b = inside[:len(outside)], outside[:len(inside)]
+    for _ in range(BISECTION_STEPS):
+        middle = (a + b) / 2
+        in_set = holds(formula, state_env(states, middle), len(middle)).unsqueeze(1)
+        a, b = torch.where(in_set, middle, a), torch.where(in_set, b, middle)
+    return a
+
+
+def sample_outside(formula, states, low, high, count: int, generator) -> torch.Tensor:
+    found, total = [], 0
+    for _ in range(MAX_ROUNDS):
+        batch = low + (high - low) * torch.rand(max(count, 64) * 2, len(states),
+                                                generator=generator, dtype=torch.float64)
+        outside = batch[~holds(formula, state_env(states, batch), len(batch))]
+        found.append(outside)
+        total += len(outside)
+        if total >= count:
+            break
+    return torch.cat(found)[:count]
+
+
+def box_centre(box) -> list[float] | None:
+    if box is None:
+        return None
+    centre = [(low + high) / 2 for low, high in zip(*box)]
+    return centre if all(map(math.isfinite, centre)) else None
+
+
+def box_scale(box) -> float:
+    if box is None:
+        return 1.0
+    return max(high - low for low, high in zip(*box))

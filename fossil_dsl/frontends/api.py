@@ -1,0 +1,50 @@
+"""The Python interface; the `fossilc` command is a thin layer over these functions."""
+from __future__ import annotations
+
+import time
+
+from fossil_dsl.frontends.build import BespokeSet, BuildError, build_spec, spec_text
+from fossil_dsl.frontends.checking import (CheckResult, check_file, check_source, check_text,
+                                           load, loads, parse)
+from fossil_dsl.engine.learner import import_optimiser_support
+from fossil_dsl.engine.loop import Cegis
+from fossil_dsl.plan.compile import Plan, compile_spec
+from fossil_dsl.kernel import Verdict, judge, not_certified
+from fossil_dsl.outputs.result import Result, build_result, claim_of
+from fossil_dsl.solvers import registry
+from fossil_dsl.solvers.fallback import FallbackBackend
+from fossil_dsl.ir.spec import CheckedSpec
+
+# re-exported: specs built in Python are part of this API
+__all__ = ["BespokeSet", "BuildError", "CheckResult", "build_spec", "check_file",
+           "check_source", "check_text", "load", "loads", "parse", "spec_text", "synthesise"]
+
+
+def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) -> Result:
+    """Compile a checked spec and run CEGIS. `options` override the synthesis block:
+    verifier, seed, max_iters, timeout, learning_rate, margin, digits, query_timeout,
+    delta (precision of a delta-decision verifier), learn_only (train, report violation
+    rates on fresh samples, prove nothing).
+    `certificate` is a Certificate subclass to use instead of the registered one."""
+    import_optimiser_support()
+    started = time.monotonic()
+    plan = compile_spec(spec, certificate=certificate, **options)
+    backend = None if plan.options.learn_only else _backend(plan)
+    outcome = Cegis(plan, backend, progress).run()
+    return build_result(plan, outcome, _judge(plan, outcome), time.monotonic() - started)
+
+
+def _judge(plan: Plan, outcome) -> Verdict:
+    """The kernel's verdict on the engine's final formulas (judged afresh from the spec
+    and those formulas alone; the engine's own answers are not used)."""
+    if not outcome.certified:
+        return not_certified(outcome.reason)
+    return judge(claim_of(plan, outcome), timeout=plan.options.query_timeout,
+                 delta=plan.options.delta)
+
+
+def _backend(plan: Plan):
+    backend = registry.load(plan.verifier, plan.options.delta)
+    if plan.fallback:
+        backend = FallbackBackend(backend, registry.load(plan.fallback, plan.options.delta))
+    return backend

@@ -1,1 +1,0 @@
-"""The learner: torch networks, samples of sets, and one loss term per condition."""

@@ -1,0 +1,202 @@
+"""`fossilc recheck DIR`: check a result again without trusting the run that made it.
+
+From the spec's text and the exact formulas in result.json, the kernel derives the
+obligations of the property afresh; each must be among the exported SMT-LIB files,
+unaltered (a missing or altered file is a failure), and each is proved again by an
+installed solver other than the one that proved it in the run. A folder without the
+spec's text (written before schema 3) is checked from its SMT-LIB files alone.
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+from fossil_dsl.check.checker import check as check_tree
+from fossil_dsl.check.context import CheckContext, Declared
+from fossil_dsl.check.expressions import ExpressionChecker
+from fossil_dsl.diagnostics import FslError, Source, Span
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
+from fossil_dsl.ir import logic as L
+from fossil_dsl.kernel import Claim, NoRule, list_obligations
+from fossil_dsl.kernel.export import script
+from fossil_dsl.kernel.obligations import file_stem
+from fossil_dsl.solvers import registry
+from fossil_dsl.solvers.api import Status
+from fossil_dsl.solvers.smtlib_reader import SmtlibError, read_script
+from fossil_dsl.syntax import ast
+from fossil_dsl.syntax.parser import parse_expression, parse_source
+
+# Which solver to try first: complete ones for polynomial queries, delta-complete ones
+# for the rest (Z3 decides no transcendental function).
+POLYNOMIAL_ORDER = ("cvc5", "z3", "interval", "dreal")
+TRANSCENDENTAL_ORDER = ("dreal", "interval", "cvc5")
+
+
+class RecheckError(FslError):
+    pass
+
+
+@dataclass(frozen=True)
+class Recheck:
+    condition: str
+    proved_by: str  # the solver the run used ("" if the run proved nothing)
+    solver: str | None  # the solver used here; None if no other one is installed
+    status: str  # "unsat" (re-proved), "sat", "unknown", "not rechecked", "missing", "altered"
+    reason: str
+    seconds: float
+
+    @property
+    def reproved(self) -> bool:
+        return self.status == "unsat"
+
+
+def recheck(directory: str | Path, timeout: float = 60.0,
+            solver: str | None = None) -> list[Recheck]:
+    """Re-derive and re-decide every obligation of the result in `directory`."""
+    folder = Path(directory)
+    data = _result(folder)
+    used = _solvers_used(data)
+    if not data.get("spec", {}).get("text"):
+        return _from_files(folder, used, timeout, solver)
+    spec, derived = _derive(data)
+    checks = []
+    for obligation in derived:
+        stem = obligation.file_stem
+        path = folder / "obligations" / f"{stem}.smt2"
+        problem = _compare(path, script(obligation, spec.states, spec.name))
+        if problem:
+            checks.append(Recheck(stem, used.get(stem, ""), None, *problem, 0.0))
+            continue
+        checks.append(_decide(stem, obligation.query, spec.states, used.get(stem, ""),
+                              timeout, solver))
+    return checks
+
+
+def _result(folder: Path) -> dict:
+    try:
+        return json.loads((folder / "result.json").read_text())
+    except (OSError, ValueError) as exc:
+        raise RecheckError(f"{folder}: cannot read result.json ({exc})") from exc
+
+
+def _solvers_used(data: dict) -> dict[str, str]:
+    used = {c["name"]: c.get("solver", "") for c in data.get("conditions", [])
+            if c.get("status") == "unsat"}
+    kernel = data.get("kernel", {}).get("obligations", [])
+    used.update({file_stem(o["name"]): o.get("procedure", "") for o in kernel
+                 if o.get("outcome") == "proved"})
+    return used
+
+
+def _derive(data: dict):
+    """The checked spec from its text, and the kernel's obligations for the formulas."""
+    source = Source(data["spec"].get("path") or "<result>", data["spec"]["text"])
+    report = check_tree(parse_source(source))
+    if report.spec is None:
+        raise RecheckError(f"{source.path}: the spec in result.json no longer checks")
+    spec = report.spec
+    claim = Claim(spec, _formulas(data.get("functions", {}), spec.states),
+                  _formulas(data.get("controller", {}), spec.states),
+                  {k: Fraction(v) for k, v in data.get("levels", {}).items()},
+                  Fraction(data.get("excluded_ball", "0")))
+    try:
+        return spec, list_obligations(claim)
+    except NoRule as exc:
+        raise RecheckError(f"the kernel has no rule for this result: {exc}") from exc
+
+
+def _formulas(texts: dict[str, str], states) -> dict[str, E.Expr]:
+    """Formulas read back by the language's own parser (never evaluated)."""
+    context = CheckContext()
+    for name in states:
+        context.names[name] = Declared("state", ast.Ident(name, Span(1, 1)))
+    reader = ExpressionChecker(context, {"state"}, "candidate")
+    found = {name: reader.convert(parse_expression(text)) for name, text in texts.items()}
+    if context.diagnostics:
+        raise RecheckError("a formula in result.json does not read back: "
+                           + "; ".join(d.message for d in context.diagnostics))
+    return found
+
+
+def _compare(path: Path, expected: str) -> tuple[str, str] | None:
+    try:
+        exported = path.read_text()
+    except OSError:
+        return "missing", f"{path.name} is not in obligations/: the run did not export it"
+    if exported != expected:
+        return "altered", f"{path.name} differs from the obligation derived from the spec"
+    return None
+
+
+def _decide(name: str, formula: L.Formula, variables, used: str, timeout: float,
+            wanted: str | None) -> Recheck:
+    solver = wanted or choose_solver(used, formula)
+    if solver is None:
+        return Recheck(name, used, None, "not rechecked",
+                       f"no installed solver other than {used} can decide it", 0.0)
+    if solver == used:
+        return Recheck(name, used, solver, "not rechecked",
+                       f"{solver} proved it in the run; a re-check needs another solver", 0.0)
+    started = time.monotonic()
+    answer = registry.load(solver).check(formula, variables, timeout)
+    return Recheck(name, used, solver, answer.status.value, _reason(answer),
+                   time.monotonic() - started)
+
+
+def _from_files(folder: Path, used: dict[str, str], timeout: float,
+                solver: str | None) -> list[Recheck]:
+    scripts = sorted((folder / "obligations").glob("*.smt2"))
+    if not scripts:
+        raise RecheckError(f"{folder}: no obligations/*.smt2 to re-check")
+    checks = []
+    for path in scripts:
+        try:
+            read = read_script(path.read_text())
+        except (OSError, SmtlibError) as exc:
+            checks.append(Recheck(path.stem, used.get(path.stem, ""), None, "not rechecked",
+                                  f"unreadable: {exc}", 0.0))
+            continue
+        checks.append(_decide(path.stem, read.formula, read.variables,
+                              used.get(path.stem, ""), timeout, solver))
+    return checks
+
+
+def choose_solver(used: str, formula: L.Formula) -> str | None:
+    """The first installed solver, other than `used`, suited to the formula."""
+    polynomial = all(traversal.is_polynomial(side) for c in L.comparisons(formula)
+                     for side in (c.left, c.right))
+    order = POLYNOMIAL_ORDER if polynomial else TRANSCENDENTAL_ORDER
+    if not L.free_vars(formula):  # a fact about numbers: no box to search
+        order = ("z3", "cvc5")
+    return next((n for n in order if n != used and registry.is_installed(n)), None)
+
+
+def _reason(answer) -> str:
+    if answer.status is Status.SAT and answer.model:
+        point = ", ".join(f"{k} = {float(v):.6g}" for k, v in answer.model.items())
+        return f"counterexample {point}"
+    return answer.reason or ""
+
+
+def report_text(checks: list[Recheck]) -> str:
+    lines = []
+    for check in checks:
+        before = f"proved by {check.proved_by}" if check.proved_by else "not proved in the run"
+        if check.status in ("missing", "altered"):
+            lines.append(f"  [{check.status.upper()}] {check.condition}: {check.reason}")
+            continue
+        if check.solver is None or check.status == "not rechecked":
+            lines.append(f"  [not rechecked] {check.condition} ({before}): {check.reason}")
+            continue
+        verdict = {"unsat": "re-proved", "sat": "FAILS", "unknown": "unknown"}[check.status]
+        extra = f": {check.reason}" if check.reason and not check.reproved else ""
+        lines.append(f"  [{verdict}] {check.condition} ({before}; rechecked by "
+                     f"{check.solver}, {check.seconds:.2f} s){extra}")
+    done = sum(c.reproved for c in checks)
+    lines.append(f"{done} of {len(checks)} obligations re-proved"
+                 + (" by another solver" if done == len(checks) else ""))
+    return "\n".join(lines)

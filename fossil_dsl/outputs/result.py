@@ -1,0 +1,325 @@
+"""The result of a run, what it means in words, and the files a user keeps: result.json,
+certificate.txt and the SMT-LIB 2 proof obligations (one file per condition)."""
+from __future__ import annotations
+
+import json
+import platform
+from importlib import metadata
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+
+import torch
+
+from fossil_dsl.version import __version__
+from fossil_dsl.engine.loop import CegisOutcome
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir.symbolic import to_sympy
+from fossil_dsl.kernel import Claim, NoRule, Verdict, not_certified
+from fossil_dsl.kernel import list_obligations as kernel_obligations
+from fossil_dsl.kernel.export import script
+from fossil_dsl.plan.compile import Plan
+from fossil_dsl.outputs.plot import phase_portrait
+from fossil_dsl.solvers import registry
+from fossil_dsl.solvers.smtlib import query_text
+
+SCHEMA_VERSION = 3  # docs/cli.md; 2 added networks, versions; 3 the kernel, spec text, ball
+
+
+@dataclass(frozen=True)
+class ConditionReport:
+    name: str
+    text: str
+    status: str  # "unsat" (proved), "sat" (counterexample), "unknown", "not verified"
+    reason: str
+    counterexample: tuple[Fraction, ...] | None
+    solver: str = ""  # which solver answered
+
+
+@dataclass(frozen=True)
+class Result:
+    plan: Plan
+    certified: bool
+    reason: str
+    formulas: dict[str, E.Expr]
+    controller: dict[str, E.Expr]  # input -> k_i(x); empty without inputs
+    levels: dict[str, Fraction]
+    conditions: tuple[ConditionReport, ...]
+    obligations: dict[str, str]  # condition name -> SMT-LIB 2 script (unsat = proved)
+    iterations: int
+    learn_seconds: float
+    verify_seconds: float
+    total_seconds: float
+    digits: int = 3  # decimals the network weights were rounded to
+    networks: dict = field(default_factory=dict)  # name -> trained torch module ("k": controller)
+    kernel: Verdict = field(default_factory=lambda: not_certified("not judged"))
+
+    @property
+    def verdict(self) -> str:
+        return "certified" if self.certified else "not certified"
+
+    @property
+    def exit_code(self) -> int:
+        return 0 if self.certified else 1
+
+    @property
+    def learn_only(self) -> bool:
+        return self.plan.options.learn_only
+
+    def guarantee(self) -> str:
+        """What is proved, in words: the kernel's, from the rule it proved."""
+        return self.kernel.guarantee if self.certified else "nothing is proved"
+
+    def assumptions(self) -> list[str]:
+        plan = self.plan
+        found = [_provers(self.conditions) + " (its queries were UNSAT) for the exact "
+                 "formulas shown", "the conditions are checked only inside the domain D"]
+        for name in dict.fromkeys(c.solver for c in self.conditions):
+            info = registry.BACKENDS[name]
+            if info.caveat:
+                found.append(info.caveat)
+            if info.delta_decision:
+                found.append(f"{name} is a delta-decision procedure: only its UNSAT "
+                             "answers are used as proofs, and it proves the closed (stronger) "
+                             "form of strict inequalities")
+        if any(f.candidate is None for f in plan.functions):
+            found.append(f"network weights were rounded to {self.digits} decimals "
+                         "before verifying; the rounded function is the one proved")
+        return found
+
+    def summary(self) -> str:
+        """The text `fossilc` prints: verdict, formulas, conditions, guarantee."""
+        return summary_text(self)
+
+    @property
+    def sympy(self) -> dict:
+        """Each function of the certificate (by name) and each controller output (by
+        input name) as an exact sympy expression over real symbols named after the
+        states."""
+        symbols: dict = {}
+        found = {name: to_sympy(f, symbols) for name, f in self.formulas.items()}
+        found.update({u: to_sympy(k, symbols) for u, k in self.controller.items()})
+        return found
+
+    def save(self, directory: str | Path) -> Path:
+        """Write result.json, certificate.txt, obligations/*.smt2 and networks.pt."""
+        return write_artefacts(self, directory)
+
+    def plot(self, path: str | Path | None = None):
+        """The phase portrait (a matplotlib Figure), also written to `path` (.png or
+        .svg) if given. 2- and 3-state specs only."""
+        return phase_portrait(self, path)
+
+    def to_json(self) -> dict:
+        plan = self.plan
+        return {
+            "schema": SCHEMA_VERSION,
+            "fossil_dsl": __version__,
+            "spec": {"name": plan.spec.name, "path": plan.spec.path,
+                     "text": plan.spec.source},
+            "property": {"form": plan.spec.property.form, "formula": plan.spec.property.text},
+            "certificate": plan.certificate.title,
+            "certificate_kind": type(plan.certificate).__name__,
+            "verdict": self.verdict,
+            "reason": self.reason,
+            "guarantee": self.guarantee(),
+            "assumptions": self.assumptions() if self.certified else [],
+            "functions": {name: str(f) for name, f in self.formulas.items()},
+            "networks": {name: network_json(n, self.digits) for name, n in self.networks.items()},
+            "controller": {name: str(f) for name, f in self.controller.items()},
+            "levels": {name: str(v) for name, v in self.levels.items()},
+            "excluded_ball": str(plan.origin_radius),
+            "learn_only": self.learn_only,
+            "conditions": [_condition_json(c) for c in self.conditions],
+            "kernel": kernel_json(self.kernel),
+            "verifier": plan.verifier,
+            "fallback": plan.fallback,
+            "iterations": self.iterations,
+            "seed": plan.options.seed,
+            "seconds": {"learn": _seconds(self.learn_seconds),
+                        "verify": _seconds(self.verify_seconds),
+                        "total": _seconds(self.total_seconds)},
+            "versions": versions(),
+        }
+
+
+def kernel_json(verdict: Verdict) -> dict:
+    """The kernel's verdict and each obligation it decided, with its procedure."""
+    return {"verdict": "certified" if verdict.certified else "not certified",
+            "reason": verdict.reason, "seconds": _seconds(verdict.seconds),
+            "obligations": [{"name": p.obligation.name, "text": p.obligation.text,
+                             "outcome": p.outcome.value, "procedure": p.procedure,
+                             "detail": p.detail, "witness": None if p.witness is None
+                             else [str(v) for v in p.witness]} for p in verdict.proofs]}
+
+
+def kernel_lines(verdict: Verdict) -> list[str]:
+    """The side facts the kernel proved (the conditions are listed above them), and a
+    tally of its procedures."""
+    if not verdict.proofs:
+        return []
+    lines = [f"  [proved by {p.procedure}] {p.obligation.text}" for p in verdict.proofs
+             if p.proved and not p.obligation.name.startswith("condition:")]
+    tally: dict[str, int] = {}
+    for proof in verdict.proofs:
+        tally[proof.procedure] = tally.get(proof.procedure, 0) + proof.proved
+    used = ", ".join(f"{name} {count}" for name, count in tally.items())
+    done = sum(p.proved for p in verdict.proofs)
+    lines.append(f"  kernel: {done} of {len(verdict.proofs)} obligations proved from the "
+                 f"spec and the exact formulas ({used}) in {verdict.seconds:.2f} s")
+    return lines
+
+
+def network_json(network, digits: int) -> dict:
+    """A network's layers with every weight and bias as an exact rational ("p/q"): the
+    values that the formulas above were built from (weights on x itself, so a first
+    layer that sees x / input_divisor is given with its weights divided)."""
+    linears = [*network.linears, network.output]
+    activations = [act.name for act in network.activations] + ["identity"]
+    layers = [{"activation": activation,
+               "weight": [[str(w) for w in row] for row in weights],
+               "bias": None if linear.bias is None else [str(b) for b in biases]}
+              for linear, activation, (weights, biases)
+              in zip(linears, activations, network.exact_layers(digits))]
+    return {"inputs": linears[0].in_features, "outputs": network.outputs,
+            "subtracts_value_at_origin": network.subtract_origin, "layers": layers}
+
+
+def versions() -> dict[str, str | None]:
+    """The versions of Python and of every package that took part."""
+    found = {"python": platform.python_version(), "fossil_dsl": __version__}
+    for package in ("torch", "z3-solver", "cvc5", "codac", "dreal", "sympy", "lark"):
+        try:
+            found[package] = metadata.version(package)
+        except metadata.PackageNotFoundError:
+            found[package] = None
+    return found
+
+
+def _provers(conditions) -> str:
+    by_solver: dict[str, list[str]] = {}
+    for condition in conditions:
+        by_solver.setdefault(condition.solver, []).append(condition.name)
+    if len(by_solver) == 1:
+        return f"every condition was proved by {next(iter(by_solver))}"
+    return "each condition was proved by the solver named: " + "; ".join(
+        f"{solver} ({', '.join(names)})" for solver, names in by_solver.items())
+
+
+def _seconds(value: float) -> float:
+    return float(f"{value:.3f}")
+
+
+def _condition_json(report: ConditionReport) -> dict:
+    point = [str(v) for v in report.counterexample] if report.counterexample else None
+    return {"name": report.name, "text": report.text, "status": report.status,
+            "reason": report.reason, "counterexample": point, "solver": report.solver}
+
+
+def claim_of(plan: Plan, outcome: CegisOutcome) -> Claim:
+    """What the engine proposes to the kernel: the spec and the final exact formulas."""
+    candidate = outcome.candidate
+    return Claim(plan.spec, dict(candidate.formulas), dict(candidate.controller),
+                 dict(candidate.levels), plan.origin_radius,
+                 {v.condition: v.solver for v in outcome.verdicts if v.solver})
+
+
+def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
+                 total_seconds: float) -> Result:
+    """The result of a run; certified exactly when the kernel's verdict is."""
+    texts = {c.name: c.text for c in plan.conditions}
+    reports = tuple(ConditionReport(v.condition, texts[v.condition],
+                                    "not verified" if plan.options.learn_only else v.status.value,
+                                    v.reason, v.counterexample, v.solver or plan.verifier)
+                    for v in outcome.verdicts)
+    candidate = outcome.candidate
+    reason = outcome.reason
+    if outcome.certified and not verdict.certified:
+        reason = f"the engine proved its conditions, but the kernel did not certify: " \
+            f"{verdict.reason}"
+    return Result(plan, verdict.certified, reason, dict(candidate.formulas),
+                  dict(candidate.controller), dict(candidate.levels), reports,
+                  obligations(plan, outcome), len(outcome.history), outcome.learn_seconds,
+                  outcome.verify_seconds, total_seconds, candidate.digits,
+                  dict(outcome.networks), verdict)
+
+
+def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
+    """The kernel's obligations for the final formulas as SMT-LIB 2 scripts (unsat
+    means proved); the engine's condition queries where the kernel has no rule."""
+    try:
+        found = kernel_obligations(claim_of(plan, outcome))
+    except NoRule:
+        return condition_scripts(plan, outcome)
+    return {o.file_stem: script(o, plan.states, plan.spec.name) for o in found}
+
+
+def condition_scripts(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
+    """Each condition's query with the certificate as a named, defined function."""
+    candidate = outcome.candidate
+    functions = {}
+    for name, formula in candidate.formulas.items():
+        functions[name] = formula
+        functions[f"d{name}"] = candidate.changes[name]
+    change = "one-step difference C(f(x)) - C(x)" if plan.certificate.discrete else \
+        "derivative along the flow, grad C . f"
+    loop = [f"closed loop with the controller {u} = {k}" for u, k in candidate.controller.items()]
+    scripts = {}
+    for condition in plan.conditions:
+        comments = [f"{plan.spec.name}: condition {condition.name}: {condition.text}",
+                    "unsat means the condition holds",
+                    f"each dC below is the {change}, computed exactly from C", *loop]
+        scripts[condition.name] = query_text(plan.query(condition), plan.states,
+                                             functions, comments, levels=candidate.levels)
+    return scripts
+
+
+def summary_text(result: Result) -> str:
+    plan = result.plan
+    lines = [f"{plan.spec.name}: {result.verdict.upper()} ({plan.spec.property.form}, "
+             f"{plan.certificate.title})"]
+    if not result.certified:
+        lines.append(f"  why: {result.reason}")
+    for name, formula in result.formulas.items():
+        lines.append(f"  {name}(x) = {formula}")
+    for name, formula in result.controller.items():
+        lines.append(f"  controller {name} = {formula}")
+    for name, value in result.levels.items():
+        lines.append(f"  level {name} = {value} (≈ {float(value):.6g})")
+    for report in result.conditions:
+        mark = {"unsat": "proved", "sat": "fails", "unknown": "unknown",
+                "not verified": "not verified"}[report.status]
+        if report.status == "unsat" and report.solver != plan.verifier:
+            mark += f" by {report.solver}"
+        extra = ""
+        if report.counterexample:
+            extra = " at (" + ", ".join(format(float(v), ".6g") for v in report.counterexample) + ")"
+        elif report.reason:
+            extra = f" ({report.reason})"
+        lines.append(f"  [{mark}] {report.text}{extra}")
+    lines += kernel_lines(result.kernel)
+    if result.learn_only:
+        lines.append("  learn-only: NOTHING WAS PROVED; the rates above are of fresh samples "
+                     "that violate each condition, which no verifier has checked")
+    lines.append(f"  guarantee: {result.guarantee()}")
+    if result.certified:
+        lines += [f"  assumes: {a}" for a in result.assumptions()]
+    verifier = "no verifier (learn-only)" if result.learn_only else f"verifier {plan.verifier}"
+    lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
+                 f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"
+                 f"{'' if result.iterations == 1 else 's'}, {verifier}, "
+                 f"seed {plan.options.seed}")
+    return "\n".join(lines)
+
+
+def write_artefacts(result: Result, directory: str | Path) -> Path:
+    out = Path(directory)
+    (out / "obligations").mkdir(parents=True, exist_ok=True)
+    (out / "result.json").write_text(json.dumps(result.to_json(), indent=2) + "\n")
+    (out / "certificate.txt").write_text(summary_text(result) + "\n")
+    for name, text in result.obligations.items():
+        (out / "obligations" / f"{name}.smt2").write_text(text)
+    if result.networks:
+        torch.save({name: network.state_dict() for name, network in result.networks.items()},
+                   out / "networks.pt")
+    return out

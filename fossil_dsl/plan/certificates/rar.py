@@ -1,0 +1,26 @@
+"""Reach, avoid, remain: reach G without leaving S (V), then remain in F (barrier B)."""
+from __future__ import annotations
+
+from fossil_dsl.plan.certificates.barrier import DEFAULT_LAYERS as BARRIER_LAYERS
+from fossil_dsl.plan.certificates.barrier import barrier_conditions
+from fossil_dsl.plan.certificates.base import Certificate, register
+from fossil_dsl.plan.certificates.rwa import DEFAULT_LAYERS, reach_conditions
+from fossil_dsl.ir.sets import Difference
+
+
+@register
+class ReachAvoidRemain(Certificate):
+    form = "reach-avoid-remain"
+    title = "reach-avoid-remain certificate (reach-while-avoid V and barrier B)"
+    keeps_equilibrium = False
+
+    def functions(self):
+        return (self.first_function("V", DEFAULT_LAYERS, zero_at_origin=False),
+                self.second_function("B", BARRIER_LAYERS, zero_at_origin=False))
+
+    def conditions(self):
+        outside_final = Difference(self.spec.domain, self.role("final"))
+        return reach_conditions(self, self.role("safe"), self.role("goal"), "S", "G") + \
+            barrier_conditions(self, "B", self.role("goal"), outside_final, "G", "D \\ F",
+                               prefix="barrier_")
+

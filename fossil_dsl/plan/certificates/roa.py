@@ -1,0 +1,54 @@
+"""Region of attraction: I lies in the origin's basin, shown by a sublevel set of V."""
+from __future__ import annotations
+
+from fossil_dsl.plan.certificates.base import (Certificate, Condition, Level, change_of, level_of,
+                                          register, value_of)
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.sets import Boundary
+from fossil_dsl.ir.spec import Layer
+
+DEFAULT_LAYERS = (Layer("square", 8),)
+
+
+def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta",
+                   prefix: str = "") -> tuple[Condition, ...]:
+    """With Ω = {x in D : V(x) <= β}: V > β on ∂D, V <= β on I, and V > 0, dV < 0 on
+    Ω minus the origin."""
+    V, dV, beta = value_of(name), change_of(name), level_of(level)
+    domain = certificate.spec.domain
+    inside_level = L.Compare("<=", V, beta)
+    change = certificate.change_word(name)
+    return (
+        Condition(f"{prefix}boundary", f"{name}(x) > β for every x on the boundary of D",
+                  Boundary(domain), L.Compare(">", V, beta)),
+        Condition(f"{prefix}initial", f"{name}(x) <= β for every x in I",
+                  certificate.role("initial"), inside_level),
+        Condition(f"{prefix}positive", f"{name}(x) > 0 for every x ≠ 0 in Ω",
+                  domain, L.Compare(">", V, E.ZERO), guard=inside_level,
+                  exclude_origin=True, scaled_margin=True),
+        Condition(f"{prefix}decrease", f"{change} < 0 for every x ≠ 0 in Ω", domain,
+                  L.Compare("<", dV, E.ZERO), guard=inside_level, exclude_origin=True,
+                  scaled_margin=True),
+    )
+
+
+def roa_level(name: str = "V", level: str = "beta", prefix: str = "") -> Level:
+    return Level(level, name, above=f"{prefix}boundary", below=f"{prefix}initial",
+                 text=f"β: between the largest {name} on I and the smallest on ∂D")
+
+
+@register
+class RegionOfAttraction(Certificate):
+    form = "region of attraction"
+    title = "region-of-attraction certificate (Lyapunov function and sublevel set)"
+
+    def functions(self):
+        return (self.first_function("V", DEFAULT_LAYERS, zero_at_origin=True),)
+
+    def conditions(self):
+        return roa_conditions(self)
+
+    def levels(self):
+        return (roa_level(),)
+

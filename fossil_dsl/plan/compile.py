@@ -1,0 +1,342 @@
+"""Checked spec -> certificate plan: the functions to learn, the conditions to prove (with
+the set each ranges over), what to sample, and which verifier decides the queries."""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from fractions import Fraction
+from types import MappingProxyType
+from typing import Mapping
+
+from fossil_dsl.plan.certificates import (Certificate, Condition, LearnedFunction, Level,
+                                     certificate_for)
+from fossil_dsl.plan.certificates.base import UnsupportedProperty
+from fossil_dsl.diagnostics import Diagnostic, FslError, Span, error
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import sets as S
+from fossil_dsl.ir.activations import ACTIVATIONS
+from fossil_dsl.ir.spec import CheckedSpec, Layer, TimeDomain
+from fossil_dsl.kernel import guarantee_text
+from fossil_dsl.kernel.obligations import BALL_ROOM
+from fossil_dsl.solvers import registry
+from fossil_dsl.solvers.smtlib import query_text
+
+DEFAULT_SAMPLES = 1000
+
+
+class CompileError(FslError):
+    """A checked spec that cannot be compiled; `span` points at the spec element."""
+
+    def __init__(self, message: str, span: Span | None = None):
+        super().__init__(message)
+        self.span = span
+
+    def diagnostic(self) -> Diagnostic:
+        return error(str(self), self.span)
+
+
+ORIGIN_RADIUS = Fraction(1, 100)  # the reference tool's annulus (its "torus" domains)
+MIN_ORIGIN_RADIUS = Fraction(1, 10 ** 6)
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    max_iters: int
+    seed: int
+    timeout: float  # seconds for the whole run
+    learning_rate: float = 0.05
+    margin: float = 0.01
+    digits: int = 3  # weights are rounded to this many decimals before verifying
+    query_timeout: float = 60.0  # seconds per verifier query
+    learn_steps: int = 1000  # gradient steps per CEGIS iteration at most
+    counterexample_neighbours: int = 20
+    control_weight: float = 0.1  # of the control loss (f(x) pointing to the goal or origin)
+    learn_only: bool = False  # train, measure violations on fresh samples, prove nothing
+    delta: float | None = None  # precision of a delta-decision verifier (its default if None)
+
+
+@dataclass(frozen=True)
+class ControllerPlan:
+    """u = k(x): a network from the states to the inputs, substituted into the dynamics."""
+
+    inputs: tuple[str, ...]
+    layers: tuple[Layer, ...]
+    zero_at_origin: bool  # k(0) = 0, so the closed loop keeps the equilibrium
+    # the set the closed loop is steered towards (the property's goal), else the origin
+    target: S.SetExpr | None = None
+
+
+@dataclass(frozen=True)
+class Plan:
+    spec: CheckedSpec
+    certificate: Certificate
+    functions: tuple[LearnedFunction, ...]
+    conditions: tuple[Condition, ...]
+    levels: tuple[Level, ...]
+    controller: ControllerPlan | None
+    verifier: str
+    verifier_reason: str
+    samples: Mapping[str, int]  # condition name -> number of training samples
+    options: RunOptions
+    # conditions that exclude the origin exclude the ball of this radius (a delta-decision
+    # verifier cannot refute a closed set that touches the origin, where V = dV = 0)
+    origin_radius: Fraction = Fraction(0)
+    fallback: str | None = None  # run alongside the verifier where it does not answer at once
+
+    @property
+    def states(self) -> tuple[str, ...]:
+        return self.spec.states
+
+    def query(self, condition: Condition) -> L.Formula:
+        """The condition's query (satisfiable exactly when it fails), before the learned
+        functions are substituted."""
+        return condition.query(self.states, self.origin_radius)
+
+    @property
+    def excludes_a_ball(self) -> bool:
+        return self.origin_radius > 0 and any(c.exclude_origin for c in self.conditions)
+
+
+def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None,
+                 **overrides) -> Plan:
+    """The plan for a checked spec; `overrides` (verifier, seed, max_iters, timeout, ...)
+    take precedence over the synthesis block, as command-line options do. `certificate`
+    replaces the registered rule for the spec's property (a user-defined one)."""
+    rule = _certificate(spec, certificate)
+    functions = rule.functions()
+    for function in functions:
+        _check_candidate(spec, function)
+    conditions = rule.conditions()
+    controller = _controller(spec, rule)
+    requested = overrides.pop("verifier", None)
+    verifier, reason = choose_verifier(spec, functions, controller, requested)
+    options = _options(spec, overrides)
+    samples = {c.name: _sample_count(spec, c.region) for c in conditions}
+    radius = origin_radius(spec) if registry.BACKENDS[verifier].delta_decision else Fraction(0)
+    fallback = None if requested or spec.synthesis.verifier else _fallback(verifier)
+    if fallback:
+        reason += f"; where it does not answer at once, {fallback} alongside"
+    return Plan(spec, rule, functions, conditions, tuple(rule.levels()), controller,
+                verifier, reason, MappingProxyType(samples), options, radius, fallback)
+
+
+def origin_radius(spec: CheckedSpec) -> Fraction:
+    """The ball a delta-decision verifier leaves out round the origin: ORIGIN_RADIUS, or
+    a power of ten small enough that ten times it fits in the domain's box (the kernel
+    proves that the larger ball lies in D)."""
+    box = spec.domain.bounding_box()
+    room = min(min(-low, high) for low, high in zip(*box)) if box else 0.0
+    radius = ORIGIN_RADIUS
+    while BALL_ROOM * radius > room and radius > MIN_ORIGIN_RADIUS:
+        radius /= 10
+    return radius
+
+
+def _fallback(verifier: str) -> str | None:
+    """The interval verifier after Z3 (when no verifier is named)."""
+    return "interval" if verifier == "z3" and registry.is_installed("interval") else None
+
+
+def _certificate(spec: CheckedSpec, given: type[Certificate] | None) -> Certificate:
+    try:
+        rule = given(spec) if given is not None else certificate_for(spec)
+    except UnsupportedProperty as exc:
+        raise CompileError(str(exc), spec.spans.get("prove")) from None
+    if spec.time is TimeDomain.DISCRETE and not rule.discrete_time:
+        raise CompileError(
+            f"{spec.property.form} in discrete time is not supported: the {rule.title} "
+            "is proved sound for continuous time only (docs/certificates.md says why)",
+            spec.spans.get("dynamics"))
+    return rule
+
+
+def _controller(spec: CheckedSpec, rule: Certificate) -> ControllerPlan | None:
+    if not spec.inputs:
+        return None
+    layers = spec.synthesis.controller or (Layer("linear", len(spec.inputs)),)
+    return ControllerPlan(spec.inputs, layers, rule.keeps_equilibrium, rule.control_target())
+
+
+def _sample_count(spec: CheckedSpec, region: S.SetExpr) -> int:
+    """`samples: NAME N` counts for the set named NAME, and for its boundary."""
+    counts = spec.synthesis.samples
+    while isinstance(region, S.Boundary):
+        region = region.inner
+    if region is spec.domain:
+        return counts.count("domain", DEFAULT_SAMPLES)
+    name = region.name if isinstance(region, S.Named) else None
+    return counts.count(name, DEFAULT_SAMPLES) if name else \
+        (counts.default or DEFAULT_SAMPLES)
+
+
+def _check_candidate(spec: CheckedSpec, function: LearnedFunction) -> None:
+    """A given function must vanish at the origin where the certificate needs it to
+    (learned networks do by construction)."""
+    if function.candidate is None or not function.zero_at_origin:
+        return
+    try:
+        at_origin = traversal.substitute(function.candidate, {s: E.ZERO for s in spec.states})
+    except E.ExprError as exc:
+        at_origin = exc
+    if at_origin != E.ZERO:
+        raise CompileError(f"the candidate {function.name} must be 0 at the origin, but "
+                           f"{function.name}(0) = {at_origin}", spec.spans.get("option:candidate"))
+
+
+def _options(spec: CheckedSpec, overrides: dict) -> RunOptions:
+    given = spec.synthesis
+    options = RunOptions(max_iters=given.max_iters, seed=given.seed, timeout=float(given.timeout))
+    if given.learning_rate is not None:
+        options = replace(options, learning_rate=float(given.learning_rate))
+    if given.margin is not None:
+        options = replace(options, margin=float(given.margin))
+    if given.delta is not None:
+        options = replace(options, delta=float(given.delta))
+    unknown = set(overrides) - set(RunOptions.__dataclass_fields__)
+    if unknown:
+        raise TypeError(f"unknown options: {sorted(unknown)}")
+    return replace(options, **{k: v for k, v in overrides.items() if v is not None})
+
+
+def is_polynomial_problem(spec: CheckedSpec, functions, controller=None) -> bool:
+    expressions = list(spec.dynamics) + [f.candidate for f in functions if f.candidate]
+    sets = [spec.domain, *spec.sets.values()]
+    formulas = [s.contains_formula(spec.states) for s in sets]
+    comparisons = [c for f in formulas for c in L.comparisons(f)]
+    expressions += [side for c in comparisons for side in (c.left, c.right)]
+    layers = [layer for f in functions if f.candidate is None for layer in f.layers]
+    layers += list(controller.layers) if controller else []
+    layers_polynomial = all(ACTIVATIONS[layer.activation].polynomial_degree is not None
+                            for layer in layers)
+    return layers_polynomial and all(traversal.is_arithmetic(e) for e in expressions)
+
+
+def choose_verifier(spec: CheckedSpec, functions, controller,
+                    requested: str | None) -> tuple[str, str]:
+    span = None if requested else spec.spans.get("option:verifier")
+    requested = requested or spec.synthesis.verifier
+    if requested:
+        if requested not in registry.BACKENDS:
+            raise CompileError(f"unknown verifier `{requested}`; the verifiers are: "
+                               + ", ".join(registry.names()), span)
+        if not registry.is_installed(requested):
+            available = [n for n in registry.names() if registry.is_installed(n)]
+            raise CompileError(f"verifier `{requested}` is not available here (it needs the "
+                               f"Python package `{registry.BACKENDS[requested].requires}`); "
+                               "available: " + ", ".join(available), span)
+        return requested, "named in the spec or on the command line"
+    if is_polynomial_problem(spec, functions, controller):
+        return "z3", "the problem is polynomial arithmetic, which Z3 decides completely"
+    missing = []
+    for info in sorted(registry.BACKENDS.values(), key=lambda b: b.rank):
+        if not info.transcendental:
+            continue
+        if registry.is_installed(info.name):
+            unavailable = f" ({', '.join(missing)} not installed)" if missing else ""
+            return info.name, (f"the problem has transcendental functions; {info.summary}"
+                               f"{unavailable}")
+        missing.append(info.name)
+    raise CompileError("no installed verifier handles transcendental functions")
+
+
+# ---- readable forms ---------------------------------------------------------------------
+def plan_text(plan: Plan, explain: bool = False) -> str:
+    spec = plan.spec
+    lines = [f"spec {spec.name}: {spec.property.form} ({spec.property.text})",
+             f"certificate: {plan.certificate.title}"]
+    for function in plan.functions:
+        shape = f"candidate {function.candidate}" if function.candidate else \
+            "network " + ", ".join(map(str, function.layers))
+        origin = f", {function.name}(0) = 0 by construction" if function.zero_at_origin else ""
+        lines.append(f"  learn {function.name}: {shape}{origin}")
+    if plan.controller:
+        controller = plan.controller
+        origin = ", k(0) = 0 by construction" if controller.zero_at_origin else ""
+        lines.append(f"  learn controller ({', '.join(controller.inputs)}) = k(x): network "
+                     + ", ".join(map(str, controller.layers)) + f"{origin}; every condition "
+                     "is proved for the closed loop with k's exact formula substituted")
+    for level in plan.levels:
+        lines.append(f"  level {level.text}, chosen at each iteration")
+    lines.append("conditions (each proved by showing its negation unsatisfiable):")
+    for condition in plan.conditions:
+        lines.append(f"  [{condition.name}] {condition.text}")
+        lines.append(f"      x ranges over {_set_words(spec, condition.region)}; "
+                     f"{plan.samples[condition.name]} training samples")
+    lines.append("dynamics (" + spec.time.value + " time):")
+    mark = "'" if spec.time.value == "continuous" else ""
+    for state, f in zip(spec.states, spec.dynamics):
+        left = f"{state}{mark}" if mark else f"next({state})"
+        lines.append(f"  {left} = {f}")
+    lines.append(f"verifier: {plan.verifier} ({plan.verifier_reason})")
+    if plan.excludes_a_ball:
+        lines.append(f"  it is a delta-decision procedure: conditions for x ≠ 0 are proved for "
+                     f"|x| > {plan.origin_radius} (ε-stability for ε = {plan.origin_radius})")
+    options = plan.options
+    lines.append(f"loop: at most {options.max_iters} iterations, {options.timeout:g} s, "
+                 f"seed {options.seed}")
+    if explain:
+        radius = plan.origin_radius if plan.excludes_a_ball else Fraction(0)
+        lines.append("guarantee, once every obligation is proved: "
+                     + guarantee_text(plan.spec, radius, plan.controller is not None))
+    return "\n".join(lines)
+
+
+def _control_loss_words(target: S.SetExpr | None) -> str:
+    if target is None:
+        return "cos(x, f(x, k(x))) over samples of the domain (f should point to 0)"
+    return (f"cos(x - c, f(x, k(x))) over samples of the domain and as many near "
+            f"{target.text()} (f should point to c, the centre of its bounding box)")
+
+
+def loss_text(plan: Plan) -> str:
+    """The learner's loss terms: one per condition, summed."""
+    margin = plan.options.margin
+    lines = ["loss = sum of one term per condition (mean over that condition's samples):"]
+    for condition in plan.conditions:
+        claim = condition.claim
+        if claim.relation in ("<", "<="):
+            violation = f"({claim.left}) - ({claim.right})"
+        else:
+            violation = f"({claim.right}) - ({claim.left})"
+        shown_margin = f"{margin:g}*|x|^2" if condition.scaled_margin else f"{margin:g}"
+        where = f"samples of {condition.region.text()}"
+        if condition.exclude_origin:
+            where += ", x != 0"
+        if condition.guard != L.TRUE:
+            where += f", where {condition.guard} (within a band)"
+        weight = "" if condition.weight == 1 else f"{condition.weight:g} * "
+        lines.append(f"  [{condition.name}] {weight}relu({violation} + {shown_margin}) "
+                     f"over {where}")
+    if plan.controller:
+        lines.append(f"  [control] {plan.options.control_weight:g} * mean of "
+                     + _control_loss_words(plan.controller.target))
+    lines.append("  ($V is the network's value, $dV its "
+                 + ("one-step difference" if plan.certificate.discrete
+                    else "derivative along the flow by automatic differentiation")
+                 + (", $beta a level set from the current samples)" if plan.levels else ")"))
+    return "\n".join(lines)
+
+
+def _set_words(spec: CheckedSpec, region: S.SetExpr) -> str:
+    if region is spec.domain:
+        return f"the domain D = {region.text()}"
+    return region.text()
+
+
+def symbolic_queries(plan: Plan) -> dict[str, str]:
+    """The verifier queries as SMT-LIB 2, with each learned function still unknown."""
+    functions = {}
+    for function in plan.functions:
+        functions[function.name] = None
+        functions[f"d{function.name}"] = None
+    result = {}
+    for condition in plan.conditions:
+        comments = [f"{plan.spec.name}: condition {condition.name}: {condition.text}",
+                    "unsat means the condition holds; d" + plan.functions[0].name +
+                    (" is the one-step difference" if plan.certificate.discrete
+                     else " is the derivative along the flow")]
+        result[condition.name] = query_text(plan.query(condition), plan.states,
+                                            functions, comments,
+                                            levels={level.name: None for level in plan.levels})
+    return result

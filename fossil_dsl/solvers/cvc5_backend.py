@@ -1,0 +1,74 @@
+"""CVC5: decides the SMT-LIB 2 text of a query (the same text that is exported), so what
+CVC5 proves is exactly what a user can re-check."""
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Sequence
+
+import cvc5
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.solvers.api import Answer, Status, UnsupportedTheory
+from fossil_dsl.solvers.smtlib import query_text
+
+
+class Cvc5Backend:
+    name = "cvc5"
+
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop=None) -> Answer:
+        """`stop` is not looked at: CVC5's API cannot be interrupted, so a query ends
+        at its own time limit."""
+        missing = _functions(formula) & NOT_IN_CVC5
+        if missing:
+            return Answer(Status.UNKNOWN, reason="CVC5 has no " + ", ".join(sorted(missing)))
+        try:
+            text = query_text(formula, variables)
+        except UnsupportedTheory as exc:
+            return Answer(Status.UNKNOWN, reason=str(exc))
+        return self.check_text(text, timeout, variables)
+
+    def check_text(self, text: str, timeout: float, variables: Sequence[str] = ()) -> Answer:
+        solver = cvc5.Solver()
+        solver.setOption("produce-models", "true")
+        solver.setOption("tlimit-per", str(max(1, int(timeout * 1000))))
+        symbols = cvc5.SymbolManager(solver.getTermManager())
+        parser = cvc5.InputParser(solver, symbols)
+        parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, _without_check_sat(text), "query")
+        try:
+            while not (command := parser.nextCommand()).isNull():
+                command.invoke(solver, symbols)
+        except RuntimeError as exc:  # cvc5's parse and API errors
+            return Answer(Status.UNKNOWN, reason=f"CVC5 could not read the script: {exc}")
+        result = solver.checkSat()
+        if result.isUnsat():
+            return Answer(Status.UNSAT)
+        if result.isSat():
+            declared = {str(t): t for t in symbols.getDeclaredTerms()}
+            values = {v: solver.getValue(declared[v]) for v in variables if v in declared}
+            irrational = not all(value.isRealValue() for value in values.values())
+            model = {v: _rational(value) for v, value in values.items()}
+            return Answer(Status.SAT, model, approximate=irrational)
+        return Answer(Status.UNKNOWN, reason=str(result.getUnknownExplanation()))
+
+
+NOT_IN_CVC5 = frozenset({"log", "sqrt"})
+
+
+def _functions(formula: L.Formula) -> set[str]:
+    return {node.func for c in L.comparisons(formula) for side in (c.left, c.right)
+            for node in E.walk(side) if isinstance(node, E.Apply)}
+
+
+def _rational(value) -> Fraction:
+    """An exact rational, or the midpoint of an isolating interval of an algebraic one."""
+    if value.isRealValue():
+        return value.getRealValue()
+    low = value.getRealAlgebraicNumberLowerBound().getRealValue()
+    high = value.getRealAlgebraicNumberUpperBound().getRealValue()
+    return (low + high) / 2
+
+
+def _without_check_sat(text: str) -> str:
+    return "\n".join(line for line in text.splitlines() if line.strip() != "(check-sat)")

@@ -1,0 +1,246 @@
+"""A delta-decision procedure on codac's outward-rounded interval arithmetic.
+
+The query is read as a closed set (strict comparisons are relaxed to non-strict ones,
+which only enlarges it), each comparison becomes codac's forward-backward contractor
+(with its centred form), `and`/`or` become intersection/union of contractors, and the
+boxes of a depth-first search are contracted and bisected:
+
+- UNSAT only when every box has been contracted to the empty set. Each contraction is an
+  interval computation under outward rounding, so the enlarged set, and therefore the
+  query, has no point in the box: the answer rests on no floating-point sampling.
+- delta-SAT when a box narrower than `delta` in every direction survives contraction;
+  its midpoint is returned as the counterexample (a lead for the learner, not a proof).
+  A box whose midpoint alone is refuted is kept aside while the search looks (for
+  WITNESS_SEARCH more boxes) for one whose midpoint is not; it is returned if none is.
+- UNKNOWN on timeout, or when contraction cannot bound every variable.
+"""
+from __future__ import annotations
+
+import threading
+import time
+from collections import Counter
+from fractions import Fraction
+from typing import Sequence
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.enclosure import function, rational_interval, upward_rounding
+from fossil_dsl.solvers.api import Answer, Status, UnsupportedTheory
+
+DELTA = 1e-4  # the width under which a surviving box counts as a (delta-)solution
+WITNESS_SEARCH = 2000  # boxes searched for a better witness after a doubtful one
+
+
+class IntervalBackend:
+    name = "interval"
+
+    def __init__(self, delta: float = DELTA):
+        self.delta = delta
+
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop: threading.Event | None = None) -> Answer:
+        names = sorted(set(variables) | L.free_vars(formula))
+        deadline = time.monotonic() + timeout
+        with upward_rounding() as codac:
+            try:
+                contractor = _Compiler(codac, names).formula(formula)
+            except UnsupportedTheory as exc:
+                return Answer(Status.UNKNOWN, reason=str(exc))
+            if contractor is None:  # the formula is TRUE: any point
+                return _unbounded() if names else Answer(Status.SAT, {})
+            start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
+            split = _worth_splitting(formula, names)
+            return self._search(contractor, start, names, split, variables, deadline, stop)
+
+    def _search(self, contractor, start, names, split, variables, deadline, stop) -> Answer:
+        contractor.contract(start)
+        if start.is_empty():
+            return Answer(Status.UNSAT)
+        if start.is_unbounded():
+            return _unbounded()
+        stack, boxes, unresolved, since = [start], 0, None, 0
+        while stack:
+            box = stack.pop()
+            boxes += 1
+            if boxes % 64 == 0 and stop is not None and stop.is_set():
+                return Answer(Status.UNKNOWN, reason=f"stopped after {boxes} boxes")
+            since += unresolved is not None
+            if since > WITNESS_SEARCH:
+                return _delta_sat(unresolved, names, variables, self.delta)
+            contractor.contract(box)
+            if box.is_empty():
+                continue
+            if max(box[i].diam() for i in split) < self.delta:
+                if _contract_to_fixpoint(contractor, box):
+                    continue
+                if _middle_may_satisfy(contractor, box):
+                    return _delta_sat(box, names, variables, self.delta)
+                # its middle is refuted: look on for a better witness, keep this one
+                unresolved = unresolved or box
+                continue
+            if boxes % 256 == 0 and time.monotonic() > deadline:
+                if unresolved is not None:
+                    return _delta_sat(unresolved, names, variables, self.delta)
+                return Answer(Status.UNKNOWN, reason=f"timeout after {boxes} boxes, "
+                              f"{len(stack) + 1} left to refute")
+            widest = max(split, key=lambda i: box[i].diam())
+            first, second = box.bisect(widest, 0.5)
+            stack += [second, first]
+        if unresolved is not None:
+            return _delta_sat(unresolved, names, variables, self.delta)
+        return Answer(Status.UNSAT)
+
+
+def _middle_may_satisfy(contractor, box) -> bool:
+    """Whether the box's middle point survives contraction: a witness the learner can
+    use, rather than a box that only interval overestimation keeps alive."""
+    middle = box.mid()
+    point = type(box)([[middle[i], middle[i]] for i in range(box.size())])
+    contractor.contract(point)
+    return not point.is_empty()
+
+
+def _worth_splitting(formula: L.Formula, names) -> list[int]:
+    """The variables to bisect: those in a comparison other than a bound `x <= c`, which
+    contraction already enforces exactly (bisecting them would only multiply boxes)."""
+    involved = set()
+    for comparison in L.comparisons(formula):
+        sides = (comparison.left, comparison.right)
+        bound = any(isinstance(a, E.Var) for a in sides) and \
+            not any(E.free_vars(side) for side in sides if not isinstance(side, E.Var))
+        if not bound:
+            involved |= E.free_vars(comparison.left) | E.free_vars(comparison.right)
+    indices = [i for i, name in enumerate(names) if name in involved]
+    return indices or list(range(len(names)))
+
+
+def _contract_to_fixpoint(contractor, box, passes: int = 50) -> bool:
+    """Contract until the box stops shrinking (one forward-backward pass is not
+    idempotent); True if it becomes empty."""
+    for _ in range(passes):
+        before = box.max_diam()
+        contractor.contract(box)
+        if box.is_empty():
+            return True
+        if box.max_diam() > 0.99 * before:
+            return False
+    return False
+
+
+def _unbounded() -> Answer:
+    return Answer(Status.UNKNOWN, reason="the query does not bound every variable, and the "
+                  "interval verifier searches bounded boxes only")
+
+
+def _delta_sat(box, names, variables, delta) -> Answer:
+    middle = box.mid()
+    point = {name: Fraction(float(middle[i])) for i, name in enumerate(names)}
+    return Answer(Status.SAT, {v: point[v] for v in variables if v in point},
+                  reason=f"delta-sat (delta = {delta:g}): a box this narrow could not be refuted",
+                  approximate=True)
+
+
+class _Compiler:
+    """Neutral formulas and expressions to codac contractors and analytic expressions."""
+
+    def __init__(self, codac, names):
+        self.codac = codac
+        self.vector = codac.VectorVar(len(names))
+        self.index = {name: i for i, name in enumerate(names)}
+        # equal subexpressions become one codac node: a network's neurons recur in its
+        # derivative, and codac then evaluates them once per box and intersects what
+        # each occurrence says about them when contracting
+        self.shared: dict[E.Expr, object] = {}
+
+    def formula(self, formula: L.Formula):
+        """A contractor for the closure of the formula's set; None for TRUE."""
+        codac = self.codac
+        if isinstance(formula, L.BoolConst):
+            return None if formula.value else codac.CtcEmpty(len(self.index))
+        if isinstance(formula, L.Not):
+            return self.formula(L.negated_inward(formula.arg))
+        if isinstance(formula, L.Compare):
+            return self.compare(formula)
+        parts = [self.formula(arg) for arg in formula.args]
+        if isinstance(formula, L.And):
+            kept = [p for p in parts if p is not None]
+            return _combine(kept, lambda a, b: a & b) if kept else None
+        if any(p is None for p in parts):
+            return None
+        return _combine(parts, lambda a, b: a | b)
+
+    def compare(self, comparison: L.Compare):
+        codac = self.codac
+        difference = E.add(comparison.left, E.neg(comparison.right))
+        if not E.free_vars(difference):
+            return self.closed_comparison(comparison.relation, difference)
+        difference = self.expr(difference)
+        function = codac.AnalyticFunction([self.vector], difference)
+        below = comparison.relation in ("<", "<=")
+        allowed = codac.Interval(-codac.oo, 0) if below else codac.Interval(0, codac.oo)
+        return codac.CtcInverse_Interval(function, allowed)
+
+    def closed_comparison(self, relation: str, difference: E.Expr):
+        """A comparison without variables: empty only when certainly false."""
+        value = self.expr(difference)
+        below = relation in ("<", "<=")
+        false = value.lb() > 0 if below else value.ub() < 0
+        return self.codac.CtcEmpty(len(self.index)) if false else None
+
+    def expr(self, expr: E.Expr):
+        translated = self.shared.get(expr)
+        if translated is None:
+            translated = self.shared[expr] = self._translate(expr)
+        return translated
+
+    def _translate(self, expr: E.Expr):
+        codac = self.codac
+        if isinstance(expr, E.Num):
+            return rational_interval(expr.value)
+        if isinstance(expr, E.Pi):
+            return codac.Interval.pi()
+        if isinstance(expr, E.Var):
+            if expr.name not in self.index:
+                raise UnsupportedTheory(f"unknown variable {expr.name}")
+            return self.vector[self.index[expr.name]]
+        if isinstance(expr, E.Neg):
+            return -self.expr(expr.operand)
+        if isinstance(expr, E.Add):
+            return _combine([self.expr(t) for t in expr.terms], lambda a, b: a + b)
+        if isinstance(expr, E.Mul):
+            # x*x as sqr(x): interval multiplication does not know both factors are one
+            counts = Counter(expr.factors)
+            factors = [self.expr(f) if n == 1 else self.power(E.Pow(f, E.Num(n)))
+                       for f, n in counts.items()]
+            return _combine(factors, lambda a, b: a * b)
+        if isinstance(expr, E.Div):
+            return self.expr(expr.numerator) / self.expr(expr.denominator)
+        if isinstance(expr, E.Pow):
+            return self.power(expr)
+        if isinstance(expr, E.Apply):
+            if not hasattr(codac, expr.func):
+                raise UnsupportedTheory(f"the interval verifier has no `{expr.func}`")
+            return function(expr.func, self.expr(expr.arg))
+        raise UnsupportedTheory(f"cannot translate {expr!r}")
+
+    def power(self, expr: E.Pow):
+        codac = self.codac
+        base = self.expr(expr.base)
+        exponent = expr.exponent
+        if isinstance(exponent, E.Num) and exponent.value.denominator == 1:
+            n = int(exponent.value)
+            if n == 2:
+                return codac.sqr(base)
+            if n >= 0:
+                return codac.pow(base, n)
+            return 1 / codac.pow(base, -n)
+        if isinstance(exponent, E.Num) and exponent.value == Fraction(1, 2):
+            return codac.sqrt(base)
+        return codac.exp(self.expr(exponent) * codac.log(base))
+
+
+def _combine(items, join):
+    result = items[0]
+    for item in items[1:]:
+        result = join(result, item)
+    return result
