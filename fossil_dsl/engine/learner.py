@@ -12,6 +12,7 @@ import time
 
 import torch
 
+from fossil_dsl.engine import linear
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
 from fossil_dsl.engine.loss import GUARD_BAND, condition_loss, guard_mask, placeholders
 from fossil_dsl.engine.networks import Network, input_divisors
@@ -65,6 +66,8 @@ class Learner(ViolationSearch):
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
+        # the linearisation's quadratic V (and LQR controller) as the starting point
+        self.seeded = linear.seed(self)
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
 
