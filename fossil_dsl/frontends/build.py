@@ -21,7 +21,7 @@ import torch
 
 from fossil_dsl.check.checker import check as check_tree
 from fossil_dsl.check.context import CheckContext
-from fossil_dsl.check.relations import RelationProver, Subject
+from fossil_dsl.check.relations import RelationProver
 from fossil_dsl.diagnostics import FslError, Source, SpecError, has_errors
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.expr import to_text
@@ -32,6 +32,7 @@ from fossil_dsl.ir.symbolic import SympyConversionError, from_sympy
 from fossil_dsl.engine.evaluate import evaluate, state_env
 from fossil_dsl.solvers.z3_backend import Z3Backend
 from fossil_dsl.syntax.parser import parse_source
+from fossil_dsl.syntax.writer import spec_head
 
 AGREEMENT_POINTS = 256  # where a torch field is compared with the formulas
 AGREEMENT_TOLERANCE = 1e-6  # relative
@@ -99,14 +100,9 @@ def spec_text(name: str, states: Sequence[str], inputs: Sequence[str], dynamics:
     names = list(states) + list(inputs)
     if len(dynamics) != len(states):
         raise BuildError(f"{len(dynamics)} dynamics expressions for {len(states)} states")
-    lines = [f"spec {name}", "", f"state {', '.join(states)}"]
-    if inputs:
-        lines.append(f"input {', '.join(inputs)}")
-    lines += ["", f"dynamics {time} {{"]
-    for state, value in zip(states, dynamics):
-        left = f"next({state})" if time == "discrete" else f"{state}'"
-        lines.append(f"    {left} = {to_text(_expr(value, names))}")
-    lines += ["}", "", f"domain {_set_text(domain, states)}"]
+    lines = spec_head(name, states, inputs, time,
+                      [to_text(_expr(value, names)) for value in dynamics])
+    lines += [f"domain {_set_text(domain, states)}"]
     lines += [f"set {key} = {_set_text(value, states)}" for key, value in sets.items()]
     lines += ["", f"prove {prove}"]
     if synthesis:

@@ -15,6 +15,7 @@ import yaml
 
 from fossil_dsl.diagnostics import FslError, SpecError
 from fossil_dsl.syntax.parser import parse_expression
+from fossil_dsl.syntax.writer import spec_head
 
 SET_ROLES = {"XD": "domain", "XI": "init", "XU": "unsafe", "XS": "safe", "XG": "goal",
              "XF": "final"}
@@ -76,15 +77,8 @@ class _Importer:
         time = str(self.config.get("TIME_DOMAIN", "CONTINUOUS")).lower()
         if time not in ("continuous", "discrete"):
             raise YamlImportError(f"TIME_DOMAIN: {time!r} is neither CONTINUOUS nor DISCRETE")
-        lines = ["# Imported from a Fossil 2.0 YAML configuration by `fossilc import-yaml`.",
-                 f"spec {self.name}", "", f"state {', '.join(states)}"]
-        if inputs:
-            lines.append(f"input {', '.join(inputs)}")
-        lines += ["", f"dynamics {time} {{"]
-        for state, equation in zip(states, system):
-            left = f"next({state})" if time == "discrete" else f"{state}'"
-            lines.append(f"    {left} = {equation}")
-        lines += ["}", ""]
+        lines = ["# Imported from a Fossil 2.0 YAML configuration by `fossilc import-yaml`."]
+        lines += spec_head(self.name, states, inputs, time, system)
         lines += [f"domain {sets.pop('domain')}"] if "domain" in sets else []
         lines += [f"set {role} = {text}" for role, text in sets.items()]
         lines += ["", f"prove {prove}"]
