@@ -67,7 +67,7 @@ class Learner(ViolationSearch):
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V (and LQR controller) as the starting point
-        self.seeded = linear.seed(self)
+        self.seeded = linear.seed(plan, self.networks.get("V"), self.controller)
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
 

@@ -87,25 +87,22 @@ def local_certificate(spec: CheckedSpec, controlled: bool):
     return P / eigenvalues[-1], K
 
 
-def seed(learner) -> bool:
-    """Set the learner's V network to the quadratic form and its controller to -K x,
+def seed(plan, network: Network | None, controller: Network | None) -> bool:
+    """Set the V network to the quadratic form and the controller network to -K x,
     where the property is stable-type and the networks can hold them exactly. Whether
     it did."""
-    plan = learner.plan
-    network = learner.networks.get("V")
     if plan.spec.property.form not in STABLE_FORMS or network is None \
             or not _holds_a_quadratic(network, len(plan.states)):
         return False
-    controlled = learner.controller is not None
-    if controlled and not _is_linear(learner.controller, len(plan.controller.inputs)):
+    if controller is not None and not _is_linear(controller, len(plan.controller.inputs)):
         return False
-    found = local_certificate(plan.spec, controlled)
+    found = local_certificate(plan.spec, controller is not None)
     if found is None:
         return False
     P, K = found
     _set_quadratic(network, P)
-    if controlled:
-        _set_linear(learner.controller, -K)
+    if controller is not None:
+        _set_linear(controller, -K)
     return True
 
 

@@ -190,7 +190,8 @@ def reach(facts: Facts) -> None:
                  facts.member(facts.role("goal")), facts.interior(facts.role("safe")))
 
 
-rule("reach", guarantee=reach_guarantee("D", "G"))(reach)  # the checker makes the safe set the domain
+# reach: the checker makes the safe set the domain
+rule("reach", guarantee=reach_guarantee("D", "G"))(reach)
 
 
 @rule("reach and stay while avoid", guarantee=(
