@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 
 from fossil_dsl.diagnostics import Diagnostic, Span, article, error, warning
 from fossil_dsl.ir.expr import Expr
+from fossil_dsl.ir.sets import SHAPES
 from fossil_dsl.syntax import ast
 
 
@@ -31,6 +32,10 @@ class CheckContext:
 
     def declare(self, kind: str, ident: ast.Ident) -> bool:
         """Record a name; a second declaration is an error and returns False."""
+        if ident.text in SHAPES:
+            self.error(f"`{ident.text}` is a reserved keyword (a set shape) and cannot be "
+                       "used as a name", ident.span)
+            return False
         previous = self.names.get(ident.text)
         if previous is not None:
             where = previous.ident.span

@@ -111,7 +111,12 @@ class SetChecker:
         return S.Semialgebraic(constraints, tuple(self.context.states))
 
     def shape(self, node: ast.Shape) -> S.SetExpr | None:
-        cls = S.SHAPES[node.kind]
+        cls = S.SHAPES.get(node.kind)
+        if cls is None:
+            hint = did_you_mean(node.kind, list(S.SHAPES))
+            self.context.error(f"unknown set shape `{node.kind}`{hint}; the shapes are "
+                               + ", ".join(S.SHAPES), node.span)
+            return None
         if len(node.args) != len(cls.SIGNATURE):
             expected = ", ".join(_SIGNATURE_WORDS[k] for k in cls.SIGNATURE)
             self.context.error(f"`{node.kind}` takes {len(cls.SIGNATURE)} arguments "

@@ -11,8 +11,9 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedTok
 from fossil_dsl.diagnostics import Diagnostic, Source, Span, did_you_mean, error
 
 KEYWORDS = ("spec state input const dynamics continuous discrete next domain set prove "
-            "from stable always eventually until and or not synthesis open box ball "
-            "ellipsoid pi").split()
+            "from stable always eventually until and or not synthesis open pi").split()
+# Shape names (box, ball, ellipsoid, ...) are reserved too; the grammar reads them as
+# names, so the checker refuses them as declared names (check/context.py).
 STATEMENTS = "spec state input const dynamics domain set prove synthesis".split()
 
 _WORDS = {
@@ -42,6 +43,9 @@ def describe_syntax_error(exc: UnexpectedInput, source: Source) -> Diagnostic:
     token = exc.token
     span = _token_span(exc, source)
     expected = _parser_expected(exc)
+    if _previous_token_type(exc) == "OPEN" and token.type != "NAME":
+        return error(f"`open` must be followed by a shape such as `ball(...)` or "
+                     f"`box(...)`, not {_shown(token)}", span)
     for labeller in _LABELLERS:
         message = labeller(token, expected)
         if message:
@@ -58,6 +62,11 @@ def _parser_expected(exc: UnexpectedToken) -> set[str]:
                 if name == name.upper()}  # terminals; rules are lower-case
     except AttributeError:
         return set(exc.expected)
+
+
+def _previous_token_type(exc: UnexpectedToken) -> str | None:
+    stack = getattr(exc.state, "value_stack", None) or [None]
+    return getattr(stack[-1], "type", None)
 
 
 def _token_span(exc: UnexpectedToken, source: Source) -> Span:
@@ -125,12 +134,6 @@ def _time_domain(token, expected):
     return None
 
 
-def _open_needs_shape(token, expected):
-    if {"BOX", "BALL", "ELLIPSOID"} <= expected and "NAME" not in expected:
-        return f"`open` must be followed by box, ball or ellipsoid, not {_shown(token)}"
-    return None
-
-
 def _incomplete(token, expected):
     if token.type in ("_NL", "$END"):
         words = sorted({token_words(name) for name in expected})[:6]
@@ -159,7 +162,7 @@ def _stray_closer(token, expected):
 
 
 _LABELLERS = (_string_literal, _keyword_as_name, _unknown_statement, _time_domain,
-              _open_needs_shape, _missing_equals, _incomplete, _missing_operator,
+              _missing_equals, _incomplete, _missing_operator,
               _missing_comma, _stray_closer)
 
 
