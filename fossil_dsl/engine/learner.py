@@ -66,8 +66,8 @@ class Learner(ViolationSearch):
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
-        # the linearisation's quadratic V (and LQR controller) as the starting point
-        self.seeded = linear.seed(plan, self.networks.get("V"), self.controller)
+        # the linearisation's quadratic V or B (and LQR controller) as the starting point
+        self.seeded = linear.seed(plan, self.networks, self.controller, self.samples)
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
 

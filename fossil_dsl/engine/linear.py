@@ -11,6 +11,8 @@ does not suffice. Nothing here is trusted: the seed is verified like any candida
 """
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 import torch
 
@@ -22,13 +24,18 @@ from fossil_dsl.ir.enclosure import enclose
 from fossil_dsl.ir.spec import CheckedSpec, TimeDomain
 
 STABLE_FORMS = ("stability", "region of attraction", "stable while avoid")
+BARRIER_FORMS = ("safety",)
+# where between the largest x^T P x on I and the smallest on U (sampled) the barrier's
+# zero level goes: low, since the quadratic's decrease is surest near the origin
+LEVEL_POSITION = 0.25
+OPERATING_STEPS = 20
 MAX_CONDITION = 1e6  # a P this ill-conditioned would not survive rounding to decimals
 
 
-def jacobians(spec: CheckedSpec) -> tuple[np.ndarray, np.ndarray] | None:
-    """A = df/dx and B = df/du at x = 0, u = 0, or None where a derivative is not a
-    finite number there."""
-    origin = {name: E.ZERO for name in (*spec.states, *spec.inputs)}
+def jacobians(spec: CheckedSpec, inputs=None) -> tuple[np.ndarray, np.ndarray] | None:
+    """A = df/dx and B = df/du at x = 0 and u = `inputs` (default 0), or None where a
+    derivative is not a finite number there."""
+    origin = _point(spec, inputs)
     try:
         rows = [[_value_at(derivative(f, v), origin) for v in (*spec.states, *spec.inputs)]
                 for f in spec.dynamics]
@@ -41,6 +48,32 @@ def jacobians(spec: CheckedSpec) -> tuple[np.ndarray, np.ndarray] | None:
     return matrix[:, :n], matrix[:, n:]
 
 
+def _point(spec: CheckedSpec, inputs=None) -> dict[str, E.Expr]:
+    values = [0.0] * len(spec.inputs) if inputs is None else inputs
+    point = {name: E.ZERO for name in spec.states}
+    point.update({name: E.Num(Fraction(float(v))) for name, v in zip(spec.inputs, values)})
+    return point
+
+
+def operating_point(spec: CheckedSpec) -> np.ndarray | None:
+    """Inputs u* that make the origin an equilibrium, f(0, u*) = 0 (Gauss-Newton from
+    u = 0; an empty vector without inputs), or None where none is found."""
+    u = np.zeros(len(spec.inputs))
+    for _ in range(OPERATING_STEPS):
+        try:
+            residual = np.array([_value_at(f, _point(spec, u)) for f in spec.dynamics])
+        except (E.ExprError, ValueError, ZeroDivisionError):
+            return None
+        if np.abs(residual).max(initial=0.0) < 1e-10:
+            return u
+        found = jacobians(spec, u)
+        if found is None or not u.size:
+            return None
+        step = np.linalg.lstsq(found[1], residual, rcond=None)[0]
+        u = u - step
+    return None
+
+
 def _value_at(expr: E.Expr, origin) -> float:
     value = traversal.substitute(expr, origin)
     if isinstance(value, E.Num):
@@ -51,12 +84,12 @@ def _value_at(expr: E.Expr, origin) -> float:
     return (low + high) / 2
 
 
-def local_certificate(spec: CheckedSpec, controlled: bool):
+def local_certificate(spec: CheckedSpec, controlled: bool, inputs=None):
     """(P, K): P positive definite with a negative definite change along the linearised
-    closed loop u = -K x (K None without inputs); None where the linearisation is not
-    stable (not stabilisable) or P is too ill-conditioned to round."""
+    closed loop u = inputs - K x (K None without inputs); None where the linearisation is
+    not stable (not stabilisable) or P is too ill-conditioned to round."""
     from scipy import linalg
-    found = jacobians(spec)
+    found = jacobians(spec, inputs)
     if found is None:
         return None
     A, B = found
@@ -87,51 +120,89 @@ def local_certificate(spec: CheckedSpec, controlled: bool):
     return P / eigenvalues[-1], K
 
 
-def seed(plan, network: Network | None, controller: Network | None) -> bool:
-    """Set the V network to the quadratic form and the controller network to -K x,
-    where the property is stable-type and the networks can hold them exactly. Whether
-    it did."""
-    if plan.spec.property.form not in STABLE_FORMS or network is None \
+def seed(plan, networks: dict[str, Network], controller: Network | None,
+         samples: dict) -> bool:
+    """Where the networks can hold them exactly: for a stable-type property, V = x^T P x;
+    for safety, B = x^T P x - c with c between its values on I and on U (from the
+    samples); and the controller -K x. Whether it seeded."""
+    form = plan.spec.property.form
+    network = networks.get("V" if form in STABLE_FORMS else "B")
+    if form not in STABLE_FORMS + BARRIER_FORMS or network is None \
             or not _holds_a_quadratic(network, len(plan.states)):
         return False
     if controller is not None and not _is_linear(controller, len(plan.controller.inputs)):
         return False
-    found = local_certificate(plan.spec, controller is not None)
+    operating = None
+    if form in BARRIER_FORMS:  # the origin need not be an equilibrium without control
+        operating = operating_point(plan.spec) if controller is not None else \
+            (np.zeros(0) if _origin_is_an_equilibrium(plan.spec) else None)
+        if operating is None or (operating.any() and controller.zero_at_origin):
+            return False
+    found = local_certificate(plan.spec, controller is not None, operating)
     if found is None:
         return False
     P, K = found
-    _set_quadratic(network, P)
+    level = 0.0
+    if form in BARRIER_FORMS:
+        level = _barrier_level(P, samples.get("initial"), samples.get("unsafe"))
+        if level is None:
+            return False
+    _set_quadratic(network, P, level)
     if controller is not None:
-        _set_linear(controller, -K)
+        _set_linear(controller, -K, operating)
     return True
 
 
+def _origin_is_an_equilibrium(spec: CheckedSpec) -> bool:
+    origin = {name: E.ZERO for name in (*spec.states, *spec.inputs)}
+    try:
+        return all(abs(_value_at(f, origin)) < 1e-12 for f in spec.dynamics)
+    except (E.ExprError, ValueError, ZeroDivisionError):
+        return False
+
+
+def _barrier_level(P: np.ndarray, initial, unsafe) -> float | None:
+    """A level c with x^T P x < c on the sampled I and > c on the sampled U, or None."""
+    if initial is None or unsafe is None or not len(initial) or not len(unsafe):
+        return None
+    matrix = torch.as_tensor(P, dtype=torch.float64)
+    inside = float(torch.einsum("bi,ij,bj->b", initial, matrix, initial).max())
+    outside = float(torch.einsum("bi,ij,bj->b", unsafe, matrix, unsafe).min())
+    if not 0 <= inside < outside:
+        return None
+    return inside + LEVEL_POSITION * (outside - inside)
+
+
 def _holds_a_quadratic(network: Network, n: int) -> bool:
-    return (network.zero_at_origin and len(network.linears) == 1
-            and network.activations[0].name == "square"
-            and network.linears[0].out_features >= n and network.divisors is None)
+    return (len(network.linears) == 1 and network.activations[0].name == "square"
+            and network.linears[0].out_features >= n)
 
 
 def _is_linear(network: Network, outputs: int) -> bool:
-    return (network.zero_at_origin and network.divisors is None
+    return (network.divisors is None
             and all(a.name == "linear" for a in network.activations)
             and len(network.linears) == 1 and network.linears[0].out_features >= outputs)
 
 
-def _set_quadratic(network: Network, P: np.ndarray) -> None:
+def _set_quadratic(network: Network, P: np.ndarray, level: float = 0.0) -> None:
     """First layer: the rows of L^T (P = L L^T), then zero rows' worth of output, so
-    V(x) = |L^T x|^2 = x^T P x exactly; the spare units start with output weight 0."""
-    factor = np.linalg.cholesky(P).T
+    V(x) = |L^T x|^2 - level = x^T P x - level exactly; the spare units start with output
+    weight 0. A layer that sees x / d (input divisors) holds L^T d."""
+    factor = torch.as_tensor(np.linalg.cholesky(P).T, dtype=torch.float64)
+    if network.divisors is not None:
+        factor = factor * network.input_divisor
     n = len(P)
     with torch.no_grad():
         weight, output = network.linears[0].weight, network.output.weight
-        weight[:n] = torch.as_tensor(factor, dtype=torch.float64)
+        weight[:n] = factor
         output.zero_()
         output[0, :n] = 1.0
+        _set_output_bias(network, [-level])
 
 
-def _set_linear(network: Network, gain: np.ndarray) -> None:
-    """k(x) = gain x: the hidden layer holds the gain, the output passes it through."""
+def _set_linear(network: Network, gain: np.ndarray, offset=None) -> None:
+    """k(x) = gain x + offset: the hidden layer holds the gain, the output passes it
+    through and adds the offset."""
     m = gain.shape[0]
     with torch.no_grad():
         hidden, output = network.linears[0].weight, network.output.weight
@@ -139,3 +210,14 @@ def _set_linear(network: Network, gain: np.ndarray) -> None:
         hidden[:m] = torch.as_tensor(gain, dtype=torch.float64)
         output.zero_()
         output[:, :m] = torch.eye(m, dtype=torch.float64)
+        _set_output_bias(network, offset)
+
+
+def _set_output_bias(network: Network, values) -> None:
+    """Hidden biases 0; the output's first biases `values` (a network without biases
+    must not be given non-zero ones)."""
+    for layer in (network.linears[0], network.output):
+        if layer.bias is not None:
+            layer.bias.zero_()
+    if values is not None and len(values) and network.output.bias is not None:
+        network.output.bias[:len(values)] = torch.as_tensor(values, dtype=torch.float64)

@@ -179,6 +179,28 @@ RULES: dict[tuple[str, TimeDomain], Callable[[Facts], None]] = {}
 GUARANTEES: dict[tuple[str, TimeDomain], str | Callable[[bool], str]] = {}
 
 
+@dataclass(frozen=True)
+class Strengthening:
+    """Further obligations that, proved on top of a rule's, give a stronger guarantee
+    (e.g. safety without "while they remain in D"). Not proving them never costs the
+    verdict, only the stronger words."""
+
+    name: str
+    add: Callable[[Facts], None]
+    guarantee: str
+
+
+STRENGTHENINGS: dict[tuple[str, TimeDomain], list[Strengthening]] = {}
+
+
+def strengthening(form: str, time: TimeDomain, name: str, guarantee: str):
+    def register(function):
+        STRENGTHENINGS.setdefault((form, time), []).append(
+            Strengthening(name, function, guarantee))
+        return function
+    return register
+
+
 def rule(form: str, *times: TimeDomain, guarantee: str | Callable[[bool], str]):
     """Register a rule, and the guarantee that its obligations, once proved, give."""
     def register(function):
@@ -189,14 +211,15 @@ def rule(form: str, *times: TimeDomain, guarantee: str | Callable[[bool], str]):
     return register
 
 
-def guarantee_text(spec: CheckedSpec, ball_radius: Fraction, controlled: bool) -> str:
-    """What a certified claim guarantees, in words: the rule's guarantee, weakened where
-    a ball round the origin was left out, and said of the closed loop where there is a
-    controller."""
+def guarantee_text(spec: CheckedSpec, ball_radius: Fraction, controlled: bool,
+                   strengthened: Strengthening | None = None) -> str:
+    """What a certified claim guarantees, in words: the rule's guarantee (or a proved
+    strengthening's), weakened where a ball round the origin was left out, and said of
+    the closed loop where there is a controller."""
     key = (spec.property.form, spec.time)
     if key not in GUARANTEES:
         raise NoRule(f"no sound rule for {key[0]} in {key[1].value} time")
-    text = GUARANTEES[key]
+    text = GUARANTEES[key] if strengthened is None else strengthened.guarantee
     text = text if isinstance(text, str) else text(spec.time is TimeDomain.DISCRETE)
     if ball_radius > 0:
         r = E.Num(ball_radius)
@@ -207,9 +230,14 @@ def guarantee_text(spec: CheckedSpec, ball_radius: Fraction, controlled: bool) -
     return text + (" (for the closed loop with the controller shown)" if controlled else "")
 
 
-def derive(claim: Claim) -> list[Obligation]:
-    """The complete list of obligations for the claim's property; NoRule if none is sound."""
-    return derive_facts(claim)[0]
+def derive(claim: Claim, strengthened: str | None = None) -> list[Obligation]:
+    """The complete list of obligations for the claim's property (with those of the
+    named strengthening); NoRule if none is sound."""
+    obligations = derive_facts(claim)[0]
+    for option, extra, _ in derive_strengthenings(claim):
+        if option.name == strengthened:
+            obligations += extra
+    return obligations
 
 
 def derive_facts(claim: Claim) -> tuple[list[Obligation], str]:
@@ -223,6 +251,19 @@ def derive_facts(claim: Claim) -> tuple[list[Obligation], str]:
     guarantee = guarantee_text(claim.spec, claim.ball_radius if facts.ball_left_out else 0,
                                bool(claim.controller))
     return _unique(facts.obligations), guarantee
+
+
+def derive_strengthenings(claim: Claim) -> list[tuple[Strengthening, list[Obligation], str]]:
+    """For each strengthening of the claim's rule, strongest first: its further
+    obligations and the guarantee the rule's and these give together."""
+    found = []
+    for option in STRENGTHENINGS.get((claim.spec.property.form, claim.spec.time), []):
+        facts = Facts(claim)
+        option.add(facts)
+        guarantee = guarantee_text(claim.spec, claim.ball_radius if facts.ball_left_out
+                                   else 0, bool(claim.controller), option)
+        found.append((option, _unique(facts.obligations), guarantee))
+    return found
 
 
 def _unique(obligations: list[Obligation]) -> list[Obligation]:

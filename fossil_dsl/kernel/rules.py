@@ -9,7 +9,8 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.kernel.obligations import BALL_ROOM, GAMMA, Facts, Obligation, rule
+from fossil_dsl.kernel.obligations import (BALL_ROOM, GAMMA, Facts, Obligation, rule,
+                                           strengthening)
 
 CONTINUOUS, DISCRETE = TimeDomain.CONTINUOUS, TimeDomain.DISCRETE
 ZERO = E.ZERO
@@ -153,6 +154,30 @@ def safety(facts: Facts) -> None:
                  facts.member(facts.spec.domain))
     facts.disjoint("relation:initial and unsafe", "I and U are disjoint", initial, unsafe)
     barrier_conditions(facts, "B", initial, unsafe, "I", "U")
+
+
+UNCONDITIONAL_SAFETY = (
+    "trajectories from I never enter U, and never leave D: B <= 0 on I, B > 0 on U within "
+    "D, the zero level set of B cannot be crossed outwards in D {how}, and {exit}")
+
+
+@strengthening("safety", CONTINUOUS, "never leaves D", UNCONDITIONAL_SAFETY.format(
+    how="(B strictly decreases wherever B = 0)",
+    exit="B > 0 on the boundary of D, so a trajectory would have to cross B = 0 in D "
+         "before it could leave D"))
+def safety_on_the_boundary(facts: Facts) -> None:
+    facts.holds("strong:boundary", "B(x) > 0 on the boundary of D",
+                facts.boundary(facts.spec.domain), compare(">", facts.value("B")))
+
+
+@strengthening("safety", DISCRETE, "never leaves D", UNCONDITIONAL_SAFETY.format(
+    how="(the set {B <= 0} is mapped into itself)",
+    exit="every x in D with B(x) <= 0 is mapped into D, so no step leaves D"))
+def safety_steps_stay_in_domain(facts: Facts) -> None:
+    domain = facts.member(facts.spec.domain)
+    image = L.substitute(domain, dict(zip(facts.states, facts.field)))
+    facts.never("strong:image", "f(x) lies in D for every x in D with B(x) <= 0",
+                L.conjunction(domain, compare("<=", facts.value("B"))), L.negation(image))
 
 
 @rule("stable while avoid", guarantee=ROA_GUARANTEE + "; and those trajectories never "

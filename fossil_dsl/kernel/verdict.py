@@ -10,11 +10,13 @@ import time
 from dataclasses import dataclass, field
 
 from fossil_dsl.kernel import rules  # noqa: F401  (registers the rules)
-from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation, derive, derive_facts
+from fossil_dsl.kernel.obligations import (Claim, NoRule, Obligation, derive, derive_facts,
+                                           derive_strengthenings)
 from fossil_dsl.kernel.prove import Outcome, Proof, discharge
 
 _SEAL = object()
 OBLIGATION_TIMEOUT = 60.0  # seconds per obligation; running out is "not proved"
+STRENGTHENING_TIMEOUT = 20.0  # per further obligation of an optional strengthening
 
 
 @dataclass(frozen=True)
@@ -24,6 +26,7 @@ class Verdict:
     proofs: tuple[Proof, ...] = ()
     seconds: float = 0.0
     guarantee: str = "nothing is proved"  # in words, from the rule; only when certified
+    strengthened: str | None = None  # the strengthening whose obligations were proved too
     _seal: object = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
@@ -39,9 +42,10 @@ def not_certified(reason: str) -> Verdict:
     return Verdict(False, reason)
 
 
-def list_obligations(claim: Claim) -> list[Obligation]:
-    """Every obligation of the claim (raises NoRule where the kernel has no rule)."""
-    return derive(claim)
+def list_obligations(claim: Claim, strengthened: str | None = None) -> list[Obligation]:
+    """Every obligation of the claim, with the named strengthening's (raises NoRule where
+    the kernel has no rule)."""
+    return derive(claim, strengthened)
 
 
 def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
@@ -60,8 +64,25 @@ def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
         if not proof.proved:
             return Verdict(False, _failure_text(proof), tuple(proofs),
                            time.monotonic() - started)
+    strengthened = None
+    for option, extra, stronger in derive_strengthenings(claim):
+        more = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta)
+        if more is not None:
+            proofs += more
+            guarantee, strengthened = stronger, option.name
+            break
     return Verdict(True, f"all {len(proofs)} obligations proved", tuple(proofs),
-                   time.monotonic() - started, guarantee, _SEAL)
+                   time.monotonic() - started, guarantee, strengthened, _SEAL)
+
+
+def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
+               delta: float | None) -> list[Proof] | None:
+    proofs = []
+    for obligation in obligations:
+        proofs.append(discharge(obligation, claim.spec.states, timeout, delta))
+        if not proofs[-1].proved:
+            return None
+    return proofs
 
 
 def _failure_text(proof: Proof) -> str:

@@ -73,7 +73,9 @@ class Result:
     def assumptions(self) -> list[str]:
         plan = self.plan
         found = [_provers(self.conditions) + " (its queries were UNSAT) for the exact "
-                 "formulas shown", "the conditions are checked only inside the domain D"]
+                 "formulas shown"]
+        if self.kernel.strengthened is None:
+            found.append("the conditions are checked only inside the domain D")
         for name in dict.fromkeys(c.solver for c in self.conditions):
             info = registry.BACKENDS[name]
             if info.caveat:
@@ -147,6 +149,7 @@ def kernel_json(verdict: Verdict) -> dict:
     """The kernel's verdict and each obligation it decided, with its procedure."""
     return {"verdict": "certified" if verdict.certified else "not certified",
             "reason": verdict.reason, "seconds": _seconds(verdict.seconds),
+            "strengthening": verdict.strengthened,
             "obligations": [{"name": p.obligation.name, "text": p.obligation.text,
                              "outcome": p.outcome.value, "procedure": p.procedure,
                              "detail": p.detail, "witness": None if p.witness is None
@@ -239,16 +242,18 @@ def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
             f"{verdict.reason}"
     return Result(plan, verdict.certified, reason, dict(candidate.formulas),
                   dict(candidate.controller), dict(candidate.levels), reports,
-                  obligations(plan, outcome), len(outcome.history), outcome.learn_seconds,
+                  obligations(plan, outcome, verdict.strengthened), len(outcome.history), outcome.learn_seconds,
                   outcome.verify_seconds, total_seconds, candidate.digits,
                   dict(outcome.networks), verdict)
 
 
-def obligations(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
-    """The kernel's obligations for the final formulas as SMT-LIB 2 scripts (unsat
-    means proved); the engine's condition queries where the kernel has no rule."""
+def obligations(plan: Plan, outcome: CegisOutcome,
+                strengthened: str | None = None) -> dict[str, str]:
+    """The kernel's obligations for the final formulas (with those of the strengthening
+    it proved) as SMT-LIB 2 scripts (unsat means proved); the engine's condition queries
+    where the kernel has no rule."""
     try:
-        found = kernel_obligations(claim_of(plan, outcome))
+        found = kernel_obligations(claim_of(plan, outcome), strengthened)
     except NoRule:
         return condition_scripts(plan, outcome)
     return {o.file_stem: script(o, plan.states, plan.spec.name) for o in found}

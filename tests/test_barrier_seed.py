@@ -1,0 +1,147 @@
+"""Safety from the linearisation: B = x^T P x - c seeded from the Lyapunov equation (LQR
+closed loop with inputs), and the kernel's stronger guarantee ("never leaves D") only
+where its further obligation is proved."""
+import json
+
+import torch
+
+import fossil_dsl
+from fossil_dsl.engine.learner import Learner
+from fossil_dsl.engine.linear import local_certificate
+from fossil_dsl.outputs.recheck import recheck
+from fossil_dsl.plan.compile import compile_spec
+
+# four weakly coupled decaying modes; the level sets of x^T P x are far from round
+DECAY = """\
+state a, b, c, d
+dynamics continuous {
+    a' = -0.2*a + 0.1*b
+    b' = -0.1*a - 0.2*b
+    c' = -0.5*c + 0.01*c^3
+    d' = -0.3*d
+}
+domain ball([0, 0, 0, 0], 4)
+set init = ball([0, 0, 0, 0], 1)
+set unsafe = ~ball([0, 0, 0, 0], 3.6)
+prove from init: always not unsafe
+"""
+
+# a double integrator with a force input and a cubic spring: unstable without control
+CART = """\
+state p, v, w
+input f, g
+dynamics continuous {
+    p' = v
+    v' = 0.3*p^3 + f
+    w' = w + g
+}
+domain ball([0, 0, 0], 3)
+set init = box([-0.2, -0.2, -0.2], [0.2, 0.2, 0.2])
+set unsafe = ~ball([0, 0, 0], 2.5)
+prove from init: always not unsafe
+"""
+
+# discrete: a rotation shrunk by 0.9
+MAP = """\
+state x, y
+dynamics discrete {
+    next(x) = 0.9*(0.6*x - 0.8*y)
+    next(y) = 0.9*(0.8*x + 0.6*y)
+}
+domain ball([0, 0], 2)
+set init = ball([0.5, 0], 0.2)
+set unsafe = ~ball([0, 0], 1.5)
+prove from init: always not unsafe
+"""
+
+
+def test_the_seeded_barrier_separates_the_sampled_sets():
+    plan = compile_spec(fossil_dsl.loads(DECAY))
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    assert learner.seeded
+    B = learner.networks["B"]
+    assert (B(learner.samples["initial"]) < 0).all()
+    assert (B(learner.samples["unsafe"]) > 0).all()
+
+
+def test_no_seed_where_the_origin_is_not_an_equilibrium():
+    shifted = DECAY.replace("d' = -0.3*d", "d' = -0.3*d + 0.01")
+    plan = compile_spec(fossil_dsl.loads(shifted))
+    assert not Learner(plan, torch.Generator().manual_seed(0)).seeded
+
+
+def test_seeded_barriers_are_certified_at_once_and_never_leave_the_domain(tmp_path):
+    for name, text in (("decay", DECAY), ("cart", CART), ("map", MAP)):
+        result = fossil_dsl.synthesise(fossil_dsl.loads(text), seed=0, timeout=120)
+        assert result.certified and result.iterations == 1, (name, result.reason)
+        assert result.kernel.strengthened == "never leaves D", name
+        assert "never leave D" in result.guarantee()
+        assert "while they remain in D" not in result.guarantee()
+        folder = tmp_path / name
+        result.save(folder)
+        data = json.loads((folder / "result.json").read_text())
+        assert data["kernel"]["strengthening"] == "never leaves D"
+        checks = recheck(folder, timeout=30)
+        names = {c.condition for c in checks}
+        assert names & {"strong-boundary", "strong-image"}, names
+        assert all(c.reproved for c in checks), [c for c in checks if not c.reproved]
+
+
+LEAVES = """\
+state x, y
+dynamics continuous {
+    x' = 1
+    y' = -y
+}
+domain box([-1, -1], [1, 1])
+set init = box([-0.5, -0.1], [-0.4, 0.1])
+set unsafe = box([2, -1], [3, 1])
+prove from init: always not unsafe
+synthesis {
+    candidate: -1
+}
+"""
+
+
+def test_a_barrier_that_holds_only_inside_the_domain_keeps_its_qualifier():
+    # every trajectory leaves D to the right and then enters U: only "while they
+    # remain in D" is true, and B = -1 proves exactly that
+    discrete = LEAVES.replace("continuous", "discrete").replace(
+        "x' = 1", "next(x) = x + 1").replace("y' = -y", "next(y) = y/2")
+    for text in (LEAVES, discrete):
+        result = fossil_dsl.synthesise(fossil_dsl.loads(text), seed=0)
+        assert result.certified, result.reason
+        assert result.kernel.strengthened is None
+        assert "while they remain in D" in result.guarantee()
+        assert "the conditions are checked only inside the domain D" in result.assumptions()
+
+
+def test_the_cart_seed_uses_the_riccati_gain():
+    spec = fossil_dsl.loads(CART)
+    P, K = local_certificate(spec, controlled=True)
+    assert K.shape == (2, 3)
+
+
+# the origin is an equilibrium only for u = (-0.5, 0): the controller's bias must hold it
+OFFSET_MAP = """\
+state x, y
+input u, v
+dynamics discrete {
+    next(x) = 0.5 - x^2 + y + u
+    next(y) = 0.2*x + v
+}
+domain ball([0, 0], 2)
+set init = box([-0.1, -0.1], [0.1, 0.1])
+set unsafe = ~ball([0, 0], 1.8)
+prove from init: always not unsafe
+"""
+
+
+def test_the_controller_holds_the_input_that_makes_the_origin_an_equilibrium():
+    plan = compile_spec(fossil_dsl.loads(OFFSET_MAP))
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    assert learner.seeded
+    at_origin = learner.controller(torch.zeros(1, 2, dtype=torch.float64))
+    assert torch.allclose(at_origin, torch.tensor([[-0.5, 0.0]], dtype=torch.float64))
+    result = fossil_dsl.synthesise(plan.spec, seed=0, timeout=60)
+    assert result.certified, result.reason
