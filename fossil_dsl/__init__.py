@@ -19,12 +19,14 @@ from fossil_dsl.version import __version__
 # `import fossil_dsl` and `fossilc check` stay fast.
 _LAZY = {"synthesise": "fossil_dsl.frontends.api", "Result": "fossil_dsl.outputs.result",
          "BespokeSet": "fossil_dsl.frontends.build", "BuildError": "fossil_dsl.frontends.build",
-         "build_spec": "fossil_dsl.frontends.build", "spec_text": "fossil_dsl.frontends.build"}
+         "build_spec": "fossil_dsl.frontends.build", "spec_text": "fossil_dsl.frontends.build",
+         "OptionError": "fossil_dsl.frontends.arguments",
+         "load_result": "fossil_dsl.outputs.load", "LoadError": "fossil_dsl.outputs.load"}
 
 __all__ = ["BespokeSet", "BuildError", "CheckResult", "CheckedSpec", "Result", "build_spec",
-           "spec_text", "Diagnostic", "FslError", "Severity", "SpecError",
+           "spec_text", "Diagnostic", "FslError", "LoadError", "OptionError", "Severity", "SpecError",
            "SpecSyntaxError", "check_file", "check_source", "check_text", "load", "loads",
-           "parse", "synthesise", "__version__"]
+           "load_result", "parse", "synthesise", "__version__"]
 
 
 def __getattr__(name: str):

@@ -262,3 +262,25 @@ def test_newlines_anywhere_inside_set_braces():
     spec = loads("state x0, x1\ndynamics continuous {\n x0' = -x0\n x1' = -x1\n}\n"
                  "domain {\n  x0 <= 1\n  , x1 <=\n    1, x0 >= -1, x1 >= -1\n}\nprove stable\n")
     assert len(spec.domain.constraints) == 4
+
+
+def test_cvc5_is_stopped_at_its_deadline_even_when_it_ignores_its_limit(monkeypatch):
+    # CVC5's nonlinear module was seen running 30 minutes past `tlimit-per`
+    import time
+    from fossil_dsl.solvers import cvc5_backend
+    monkeypatch.setattr(cvc5_backend, "_solve", lambda *args: time.sleep(600))
+    monkeypatch.setattr(cvc5_backend, "GRACE_SECONDS", 0.5)
+    started = time.monotonic()
+    answer = cvc5_backend.Cvc5Backend().check_text(
+        "(set-logic QF_NRA)\n(declare-const x Real)\n(assert (> x 0))\n(check-sat)\n", 1.0)
+    assert answer.status.value == "unknown" and "stopped" in answer.reason
+    assert time.monotonic() - started < 3
+
+
+def test_cvc5_answers_from_its_child_process():
+    from fossil_dsl.solvers import cvc5_backend
+    text = "(set-logic QF_NRA)\n(declare-const x Real)\n(assert (> (* x x) 2))\n(check-sat)\n"
+    sat = cvc5_backend.Cvc5Backend().check_text(text, 5.0, ["x"])
+    assert sat.status.value == "sat" and sat.model["x"] ** 2 > 2
+    unsat = cvc5_backend.Cvc5Backend().check_text(text.replace("> (* x x) 2", "< (* x x) -1"), 5.0)
+    assert unsat.status.value == "unsat"

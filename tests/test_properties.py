@@ -8,7 +8,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+import torch
 
 import fossil_dsl
 from fossil_dsl.plan.certificates import base as certificate_registry
@@ -62,6 +64,46 @@ def test_property_certified_end_to_end(name, tmp_path):
     exported = json.loads((tmp_path / "result.json").read_text())
     assert exported["controller"] == {u: str(k) for u, k in result.controller.items()}
     assert exported["levels"] == {n: str(v) for n, v in result.levels.items()}
+    assert_loads_back(result, tmp_path)
+    assert_onnx_agrees(result, tmp_path)
+
+
+def assert_loads_back(result, folder):
+    """run -> save -> load_result -> the same result, judged again by the kernel."""
+    loaded = fossil_dsl.load_result(folder)
+    assert loaded.certified and loaded.kernel.certified
+    assert loaded.formulas == result.formulas and loaded.controller == result.controller
+    assert loaded.levels == result.levels and loaded.digits == result.digits
+    assert loaded.plan.spec.property.form == result.plan.spec.property.form
+    assert loaded.plan.options.seed == result.plan.options.seed
+    assert loaded.conditions == result.conditions and loaded.obligations == result.obligations
+    assert loaded.guarantee() == result.guarantee()
+    assert loaded.sympy == result.sympy
+    points = torch.rand(20, len(result.plan.states), dtype=torch.float64)
+    for name, network in result.networks.items():
+        assert torch.allclose(loaded.networks[name](points), network(points)), name
+
+
+def assert_onnx_agrees(result, folder, count=200):
+    """certificate.onnx (and controller.onnx) evaluated by ONNX Runtime at random points
+    of the domain's box agree with the exact formulas to 1e-6 relative."""
+    import onnxruntime
+    from fossil_dsl.engine.evaluate import evaluate
+    low, high = (torch.tensor(side, dtype=torch.float64)
+                 for side in result.plan.spec.domain.bounding_box())
+    points = low + (high - low) * torch.rand(count, len(low), dtype=torch.float64)
+    env = {s: points[:, i] for i, s in enumerate(result.plan.states)}
+    for file, formulas in (("certificate.onnx", result.formulas),
+                           ("controller.onnx", result.controller)):
+        if not formulas:
+            assert not (folder / file).exists()
+            continue
+        session = onnxruntime.InferenceSession(str(folder / file))
+        values = session.run(None, {"x": points.numpy()})[0]
+        for column, formula in enumerate(formulas.values()):
+            exact = (evaluate(formula, env) * torch.ones(count, dtype=torch.float64)).numpy()
+            scale = np.maximum(np.abs(exact), 1.0)
+            assert (np.abs(values[:, column] - exact) <= 1e-6 * scale).all(), (file, column)
 
 
 def test_two_function_certificates_report_both():

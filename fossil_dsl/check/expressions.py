@@ -14,6 +14,10 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.syntax import ast
 
 MAX_DECIMAL_EXPONENT = 1000
+# The largest magnitude of a number in the model (docs/language.md): the learner computes
+# in float64 next to values of order 1 (1e300 * x^2 overflows), and rounded weights
+# cannot balance such a term; candidates are exempt (never learned, proved exactly).
+LARGEST_NUMBER = Fraction(10) ** 12
 _NUMBER = re.compile(r"(?P<mantissa>[0-9.]+)(?:[eE](?P<exponent>[+-]?\d+))?$")
 
 _ALLOWED_WORDS = {
@@ -23,6 +27,14 @@ _ALLOWED_WORDS = {
     "parameter": "numbers and constants",
     "candidate": "states and constants",
 }
+
+
+def _magnitude_text(value: Fraction) -> str:
+    """A short text for a number of any size (float() overflows past 1e308)."""
+    digits = len(str(abs(value.numerator))) - len(str(value.denominator))
+    if abs(digits) < 300:
+        return f"{float(value):.6g}"
+    return f"{'-' if value < 0 else ''}about 1e{digits}"
 
 
 class ExpressionChecker:
@@ -42,6 +54,14 @@ class ExpressionChecker:
         if traversal.degree(value) > E.MAX_DEGREE:
             self.context.error(f"this expression has degree up to {traversal.degree(value)}; at most "
                                f"{E.MAX_DEGREE} is supported (solvers stall beyond)", node.span)
+            return E.ZERO
+        extreme = next((n.value for n in E.walk(value) if isinstance(n, E.Num)
+                        and abs(n.value) > LARGEST_NUMBER), None)
+        if extreme is not None and self.where != "candidate":
+            self.context.error(
+                f"the number {_magnitude_text(extreme)} is larger than the learner and the "
+                "solvers handle faithfully (magnitudes up to 1e12); rescale the units of "
+                "the model", node.span)
             return E.ZERO
         return value
 

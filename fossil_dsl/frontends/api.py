@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import time
 
+from fossil_dsl.frontends.arguments import OptionError, check_options
 from fossil_dsl.frontends.build import BespokeSet, BuildError, build_spec, spec_text
 from fossil_dsl.frontends.checking import (CheckResult, check_file, check_source, check_text,
                                            load, loads, parse)
@@ -16,7 +17,7 @@ from fossil_dsl.solvers.fallback import FallbackBackend
 from fossil_dsl.ir.spec import CheckedSpec
 
 # re-exported: specs built in Python are part of this API
-__all__ = ["BespokeSet", "BuildError", "CheckResult", "build_spec", "check_file",
+__all__ = ["BespokeSet", "BuildError", "CheckResult", "OptionError", "build_spec", "check_file",
            "check_source", "check_text", "load", "loads", "parse", "spec_text", "synthesise"]
 
 
@@ -26,6 +27,7 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) ->
     delta (precision of a delta-decision verifier), learn_only (train, report violation
     rates on fresh samples, prove nothing).
     `certificate` is a Certificate subclass to use instead of the registered one."""
+    options = check_options(options)  # a bad value raises OptionError before any work
     import_optimiser_support()
     started = time.monotonic()
     plan = compile_spec(spec, certificate=certificate, **options)

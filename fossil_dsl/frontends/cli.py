@@ -20,6 +20,7 @@ from rich.console import Console
 from rich.progress import Progress, TextColumn
 
 from fossil_dsl.diagnostics import error
+from fossil_dsl.frontends import arguments
 from fossil_dsl.frontends.checking import CheckResult, check_file, check_text
 from fossil_dsl.plan.compile import CompileError, compile_spec, loss_text, plan_text, symbolic_queries
 from fossil_dsl.solvers.registry import BackendUnavailable
@@ -70,7 +71,8 @@ def _report_verifier(result: CheckResult, out: Console, err: Console) -> bool:
 
 def command_run(args: argparse.Namespace) -> int:
     from fossil_dsl.frontends.api import synthesise
-    from fossil_dsl.outputs.result import summary_text, write_artefacts
+    from fossil_dsl.outputs.artefacts import write_artefacts
+    from fossil_dsl.outputs.summary import summary_text
     out, err = _consoles()
     result = check_file(args.spec)
     _report(result, out, err, args.quiet or args.json, summary=not args.json)
@@ -152,12 +154,17 @@ def _run_parser() -> argparse.ArgumentParser:
         epilog="other commands: `fossilc check SPEC...`, `fossilc compile SPEC --emit "
         "plan|smt2|losses`, `fossilc bench FILES_OR_DIRS`, `fossilc recheck DIR`, `fossilc import-yaml CONFIG.yaml` (each has --help)")
     parser.add_argument("spec", help="the .fsl file")
-    parser.add_argument("-o", "--output", metavar="DIR",
-                        help="write result.json, certificate.txt and obligations/*.smt2")
-    parser.add_argument("--verifier", help="z3, cvc5, dreal or interval")
-    parser.add_argument("--seed", type=int, help="random seed (the same seed, the same run)")
-    parser.add_argument("--max-iters", type=int, help="CEGIS iterations before giving up")
-    parser.add_argument("--timeout", type=float, help="seconds for the whole run")
+    parser.add_argument("-o", "--output", metavar="DIR", type=arguments.FOLDER,
+                        help="write result.json, certificate.txt and obligations/*.smt2 "
+                        "(the folder is created, and checked writable, before the run)")
+    parser.add_argument("--verifier", type=arguments.SOLVER,
+                        help="z3, cvc5, dreal or interval")
+    parser.add_argument("--seed", type=arguments.SEED,
+                        help="random seed, 0 or more (the same seed, the same run)")
+    parser.add_argument("--max-iters", type=arguments.ITERATIONS,
+                        help="CEGIS iterations before giving up (at least 1)")
+    parser.add_argument("--timeout", type=arguments.SECONDS,
+                        help="seconds for the whole run (positive)")
     parser.add_argument("--learn-only", action="store_true",
                         help="train without verifying; report how many fresh samples "
                         "violate each condition (nothing is proved)")
@@ -178,7 +185,8 @@ def _compile_parser() -> argparse.ArgumentParser:
     parser.add_argument("--emit", choices=["plan", "smt2", "losses"], default="plan")
     parser.add_argument("--explain", action="store_true",
                         help="also print the plan and the guarantee in words")
-    parser.add_argument("--verifier", help="z3, cvc5, dreal or interval")
+    parser.add_argument("--verifier", type=arguments.SOLVER,
+                        help="z3, cvc5, dreal or interval")
     parser.set_defaults(handler=command_compile)
     return parser
 
@@ -223,12 +231,15 @@ def _bench_parser() -> argparse.ArgumentParser:
                                      description="Run specs with several seeds, each in its "
                                      "own process, and tabulate success and time.")
     parser.add_argument("paths", nargs="+", metavar="FILE_OR_DIR", help=".fsl files or folders")
-    parser.add_argument("--seeds", type=int, default=10, help="seeds 0..N-1 (default 10)")
-    parser.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1)")
-    parser.add_argument("--verifier", help="z3, cvc5, dreal or interval (default: per spec)")
-    parser.add_argument("--timeout", type=float, default=600.0,
+    parser.add_argument("--seeds", type=arguments.COUNT, default=10,
+                        help="seeds 0..N-1 (default 10)")
+    parser.add_argument("--jobs", type=arguments.COUNT, default=1,
+                        help="runs at a time (default 1)")
+    parser.add_argument("--verifier", type=arguments.SOLVER,
+                        help="z3, cvc5, dreal or interval (default: per spec)")
+    parser.add_argument("--timeout", type=arguments.SECONDS, default=600.0,
                         help="seconds per run (default 600)")
-    parser.add_argument("--out", default="benchmarks/results/latest",
+    parser.add_argument("--out", default="benchmarks/results/latest", type=arguments.FOLDER,
                         help="folder for runs.csv, table.csv and table.md")
     parser.set_defaults(handler=command_bench)
     return parser
@@ -252,9 +263,10 @@ def _recheck_parser() -> argparse.ArgumentParser:
         "result folder (written by `fossilc SPEC -o DIR`), each with an installed solver "
         "other than the one that proved it. Exit 0 if every one is re-proved, 1 if not.")
     parser.add_argument("directory", metavar="DIR", help="the folder `-o DIR` wrote")
-    parser.add_argument("--solver", help="use this solver for every obligation "
+    parser.add_argument("--solver", type=arguments.SOLVER,
+                        help="use this solver for every obligation "
                         "(default: the first suitable one that did not prove it)")
-    parser.add_argument("--timeout", type=float, default=60.0,
+    parser.add_argument("--timeout", type=arguments.SECONDS, default=60.0,
                         help="seconds per obligation (default 60)")
     parser.set_defaults(handler=command_recheck)
     return parser
@@ -289,7 +301,7 @@ def _import_yaml_parser() -> argparse.ArgumentParser:
         prog="fossilc import-yaml", description="Translate a Fossil 2.0 YAML configuration "
         "into a .fsl spec, say what could not be translated, and check the result.")
     parser.add_argument("config", metavar="CONFIG.yaml")
-    parser.add_argument("-o", "--output", metavar="SPEC.fsl",
+    parser.add_argument("-o", "--output", metavar="SPEC.fsl", type=arguments.FILE,
                         help="write the spec here (default: print it)")
     parser.set_defaults(handler=command_import_yaml)
     return parser

@@ -77,6 +77,7 @@ class Facts:
         self.r = claim.ball_radius
         self.obligations: list[Obligation] = []
         self.ball_left_out = False  # some obligation excludes the ball |x| <= r
+        self.ball_covered = False  # ... and the Taylor lemma's obligations cover it
 
     # ---- sets and functions ----
     def role(self, name: str) -> S.SetExpr:
@@ -186,17 +187,19 @@ class Strengthening:
     verdict, only the stronger words."""
 
     name: str
-    add: Callable[[Facts], None]
-    guarantee: str
+    add: Callable[[Facts], bool | None]  # False: does not apply to this claim
+    guarantee: str | Callable[[bool], str]
 
 
 STRENGTHENINGS: dict[tuple[str, TimeDomain], list[Strengthening]] = {}
 
 
-def strengthening(form: str, time: TimeDomain, name: str, guarantee: str):
+def strengthening(form: str, *times: TimeDomain, name: str,
+                  guarantee: str | Callable[[bool], str]):
     def register(function):
-        STRENGTHENINGS.setdefault((form, time), []).append(
-            Strengthening(name, function, guarantee))
+        for time in times:
+            STRENGTHENINGS.setdefault((form, time), []).append(
+                Strengthening(name, function, guarantee))
         return function
     return register
 
@@ -248,7 +251,8 @@ def derive_facts(claim: Claim) -> tuple[list[Obligation], str]:
         raise NoRule(f"no sound rule for {key[0]} in {key[1].value} time")
     common(facts)
     RULES[key](facts)
-    guarantee = guarantee_text(claim.spec, claim.ball_radius if facts.ball_left_out else 0,
+    excluded = facts.ball_left_out and not facts.ball_covered
+    guarantee = guarantee_text(claim.spec, claim.ball_radius if excluded else 0,
                                bool(claim.controller))
     return _unique(facts.obligations), guarantee
 
@@ -259,7 +263,8 @@ def derive_strengthenings(claim: Claim) -> list[tuple[Strengthening, list[Obliga
     found = []
     for option in STRENGTHENINGS.get((claim.spec.property.form, claim.spec.time), []):
         facts = Facts(claim)
-        option.add(facts)
+        if option.add(facts) is False:
+            continue
         guarantee = guarantee_text(claim.spec, claim.ball_radius if facts.ball_left_out
                                    else 0, bool(claim.controller), option)
         found.append((option, _unique(facts.obligations), guarantee))

@@ -9,6 +9,7 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.kernel.local import negative_near_origin
 from fossil_dsl.kernel.obligations import (BALL_ROOM, GAMMA, Facts, Obligation, rule,
                                            strengthening)
 
@@ -52,9 +53,15 @@ def neighbourhood(facts: Facts) -> None:
         facts.inside("ball:room", f"the ball |x| <= {radius} ({BALL_ROOM} times the "
                      "excluded ball) lies in D", facts.ball(radius), domain)
     if facts.r > 0 and facts.discrete:
-        image = E.add(*(E.power(f, E.Num(2)) for f in facts.field))
-        facts.never("ball:image", f"the map sends the excluded ball |x| <= {facts.r} into "
-                    "itself", facts.ball(facts.r), compare(">", image, E.Num(facts.r ** 2)))
+        # a step can land in the ball the conditions left out: either the Taylor lemma
+        # covers the ball (V > 0 and V decreasing there too), or the ball is mapped
+        # into itself (the ε-stability argument)
+        facts.ball_covered = no_ball_left_out(facts)
+        if not facts.ball_covered:
+            image = E.add(*(E.power(f, E.Num(2)) for f in facts.field))
+            facts.never("ball:image", f"the map sends the excluded ball |x| <= {facts.r} "
+                        "into itself", facts.ball(facts.r),
+                        compare(">", image, E.Num(facts.r ** 2)))
 
 
 def away_words(facts: Facts) -> str:
@@ -76,6 +83,14 @@ def stability_guarantee(discrete: bool) -> str:
     return ("the origin is asymptotically stable: V is positive away from the origin "
             f"and strictly decreases {step} in the domain, so trajectories that remain in "
             "the domain converge to the origin (V(0) = 0)")
+
+
+def no_ball_left_out(facts: Facts) -> bool:
+    """V > 0 and V decreasing also inside the excluded ball (but at 0), from the Taylor
+    expansions there (kernel/local.py): the ε of ε-stability goes."""
+    V = facts.value("V")
+    return facts.r > 0 and negative_near_origin(facts, "positive", E.neg(V), "-V") \
+        and negative_near_origin(facts, "decrease", facts.change("V"), "the change of V")
 
 
 ROA_GUARANTEE = (
@@ -106,6 +121,11 @@ def stability(facts: Facts) -> None:
     lyapunov_conditions(facts, facts.closure(facts.spec.domain), "the closure of D")
 
 
+# (in discrete time the rule itself uses the lemma where it applies: see neighbourhood)
+strengthening("stability", CONTINUOUS, name="no ball left out",
+              guarantee=stability_guarantee)(no_ball_left_out)
+
+
 def region_of_attraction(facts: Facts) -> None:
     equilibrium(facts, "V")
     neighbourhood(facts)
@@ -127,6 +147,8 @@ def region_of_attraction(facts: Facts) -> None:
 
 
 rule("region of attraction", guarantee=ROA_GUARANTEE)(region_of_attraction)
+strengthening("region of attraction", CONTINUOUS, name="no ball left out",
+              guarantee=ROA_GUARANTEE)(no_ball_left_out)
 
 
 def barrier_conditions(facts: Facts, name: str, inside: L.Formula, outside: L.Formula,
@@ -161,7 +183,7 @@ UNCONDITIONAL_SAFETY = (
     "D, the zero level set of B cannot be crossed outwards in D {how}, and {exit}")
 
 
-@strengthening("safety", CONTINUOUS, "never leaves D", UNCONDITIONAL_SAFETY.format(
+@strengthening("safety", CONTINUOUS, name="never leaves D", guarantee= UNCONDITIONAL_SAFETY.format(
     how="(B strictly decreases wherever B = 0)",
     exit="B > 0 on the boundary of D, so a trajectory would have to cross B = 0 in D "
          "before it could leave D"))
@@ -170,7 +192,7 @@ def safety_on_the_boundary(facts: Facts) -> None:
                 facts.boundary(facts.spec.domain), compare(">", facts.value("B")))
 
 
-@strengthening("safety", DISCRETE, "never leaves D", UNCONDITIONAL_SAFETY.format(
+@strengthening("safety", DISCRETE, name="never leaves D", guarantee= UNCONDITIONAL_SAFETY.format(
     how="(the set {B <= 0} is mapped into itself)",
     exit="every x in D with B(x) <= 0 is mapped into D, so no step leaves D"))
 def safety_steps_stay_in_domain(facts: Facts) -> None:
@@ -180,8 +202,17 @@ def safety_steps_stay_in_domain(facts: Facts) -> None:
                 L.conjunction(domain, compare("<=", facts.value("B"))), L.negation(image))
 
 
-@rule("stable while avoid", guarantee=ROA_GUARANTEE + "; and those trajectories never "
-      "enter U: B <= 0 on I, B > 0 on U, and B strictly decreases wherever B = 0 in D")
+SWA_GUARANTEE = ROA_GUARANTEE + ("; and those trajectories never enter U: B <= 0 on I, "
+                                 "B > 0 on U, and B strictly decreases wherever B = 0 in D")
+
+
+@strengthening("stable while avoid", CONTINUOUS, name="no ball left out",
+               guarantee=SWA_GUARANTEE)
+def swa_without_ball(facts: Facts) -> bool:
+    return no_ball_left_out(facts)
+
+
+@rule("stable while avoid", guarantee=SWA_GUARANTEE)
 def stable_while_avoid(facts: Facts) -> None:
     region_of_attraction(facts)
     initial, unsafe = facts.member(facts.role("initial")), facts.member(facts.role("unsafe"))

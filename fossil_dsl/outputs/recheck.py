@@ -94,13 +94,9 @@ def _solvers_used(data: dict) -> dict[str, str]:
 
 def _derive(data: dict):
     """The checked spec from its text, and the kernel's obligations for the formulas."""
-    source = Source(data["spec"].get("path") or "<result>", data["spec"]["text"])
-    report = check_tree(parse_source(source))
-    if report.spec is None:
-        raise RecheckError(f"{source.path}: the spec in result.json no longer checks")
-    spec = report.spec
-    claim = Claim(spec, _formulas(data.get("functions", {}), spec.states),
-                  _formulas(data.get("controller", {}), spec.states),
+    spec = checked_spec(data)
+    claim = Claim(spec, read_formulas(data.get("functions", {}), spec.states),
+                  read_formulas(data.get("controller", {}), spec.states),
                   {k: Fraction(v) for k, v in data.get("levels", {}).items()},
                   Fraction(data.get("excluded_ball", "0")))
     try:
@@ -109,7 +105,18 @@ def _derive(data: dict):
         raise RecheckError(f"the kernel has no rule for this result: {exc}") from exc
 
 
-def _formulas(texts: dict[str, str], states) -> dict[str, E.Expr]:
+def checked_spec(data: dict):
+    """The spec of a result.json, from its text, checked again."""
+    if not data.get("spec", {}).get("text"):
+        raise RecheckError("result.json has no spec text (written before schema 3)")
+    source = Source(data["spec"].get("path") or "<result>", data["spec"]["text"])
+    report = check_tree(parse_source(source))
+    if report.spec is None:
+        raise RecheckError(f"{source.path}: the spec in result.json no longer checks")
+    return report.spec
+
+
+def read_formulas(texts: dict[str, str], states) -> dict[str, E.Expr]:
     """Formulas read back by the language's own parser (never evaluated)."""
     context = CheckContext()
     for name in states:

@@ -9,8 +9,6 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
-import torch
-
 from fossil_dsl.version import __version__
 from fossil_dsl.engine.loop import CegisOutcome
 from fossil_dsl.ir import expr as E
@@ -19,7 +17,9 @@ from fossil_dsl.kernel import Claim, NoRule, Verdict, not_certified
 from fossil_dsl.kernel import list_obligations as kernel_obligations
 from fossil_dsl.kernel.export import script
 from fossil_dsl.plan.compile import Plan
+from fossil_dsl.outputs.artefacts import write_artefacts
 from fossil_dsl.outputs.plot import phase_portrait
+from fossil_dsl.outputs.summary import summary_text
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.smtlib import query_text
 
@@ -138,6 +138,7 @@ class Result:
             "fallback": plan.fallback,
             "iterations": self.iterations,
             "seed": plan.options.seed,
+            "digits": self.digits,
             "seconds": {"learn": _seconds(self.learn_seconds),
                         "verify": _seconds(self.verify_seconds),
                         "total": _seconds(self.total_seconds)},
@@ -154,23 +155,6 @@ def kernel_json(verdict: Verdict) -> dict:
                              "outcome": p.outcome.value, "procedure": p.procedure,
                              "detail": p.detail, "witness": None if p.witness is None
                              else [str(v) for v in p.witness]} for p in verdict.proofs]}
-
-
-def kernel_lines(verdict: Verdict) -> list[str]:
-    """The side facts the kernel proved (the conditions are listed above them), and a
-    tally of its procedures."""
-    if not verdict.proofs:
-        return []
-    lines = [f"  [proved by {p.procedure}] {p.obligation.text}" for p in verdict.proofs
-             if p.proved and not p.obligation.name.startswith("condition:")]
-    tally: dict[str, int] = {}
-    for proof in verdict.proofs:
-        tally[proof.procedure] = tally.get(proof.procedure, 0) + proof.proved
-    used = ", ".join(f"{name} {count}" for name, count in tally.items())
-    done = sum(p.proved for p in verdict.proofs)
-    lines.append(f"  kernel: {done} of {len(verdict.proofs)} obligations proved from the "
-                 f"spec and the exact formulas ({used}) in {verdict.seconds:.2f} s")
-    return lines
 
 
 def network_json(network, digits: int) -> dict:
@@ -230,7 +214,10 @@ def claim_of(plan: Plan, outcome: CegisOutcome) -> Claim:
 def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
                  total_seconds: float) -> Result:
     """The result of a run; certified exactly when the kernel's verdict is."""
-    texts = {c.name: c.text for c in plan.conditions}
+    # the queries left out the ball |x| <= r (the kernel may prove its inside apart)
+    texts = {c.name: c.text + (f" (queried for |x| > {E.Num(plan.origin_radius)})"
+                               if c.exclude_origin and plan.origin_radius > 0 else "")
+             for c in plan.conditions}
     reports = tuple(ConditionReport(v.condition, texts[v.condition],
                                     "not verified" if plan.options.learn_only else v.status.value,
                                     v.reason, v.counterexample, v.solver or plan.verifier)
@@ -277,54 +264,3 @@ def condition_scripts(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
         scripts[condition.name] = query_text(plan.query(condition), plan.states,
                                              functions, comments, levels=candidate.levels)
     return scripts
-
-
-def summary_text(result: Result) -> str:
-    plan = result.plan
-    lines = [f"{plan.spec.name}: {result.verdict.upper()} ({plan.spec.property.form}, "
-             f"{plan.certificate.title})"]
-    if not result.certified:
-        lines.append(f"  why: {result.reason}")
-    for name, formula in result.formulas.items():
-        lines.append(f"  {name}(x) = {formula}")
-    for name, formula in result.controller.items():
-        lines.append(f"  controller {name} = {formula}")
-    for name, value in result.levels.items():
-        lines.append(f"  level {name} = {value} (≈ {float(value):.6g})")
-    for report in result.conditions:
-        mark = {"unsat": "proved", "sat": "fails", "unknown": "unknown",
-                "not verified": "not verified"}[report.status]
-        if report.status == "unsat" and report.solver != plan.verifier:
-            mark += f" by {report.solver}"
-        extra = ""
-        if report.counterexample:
-            extra = " at (" + ", ".join(format(float(v), ".6g") for v in report.counterexample) + ")"
-        elif report.reason:
-            extra = f" ({report.reason})"
-        lines.append(f"  [{mark}] {report.text}{extra}")
-    lines += kernel_lines(result.kernel)
-    if result.learn_only:
-        lines.append("  learn-only: NOTHING WAS PROVED; the rates above are of fresh samples "
-                     "that violate each condition, which no verifier has checked")
-    lines.append(f"  guarantee: {result.guarantee()}")
-    if result.certified:
-        lines += [f"  assumes: {a}" for a in result.assumptions()]
-    verifier = "no verifier (learn-only)" if result.learn_only else f"verifier {plan.verifier}"
-    lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
-                 f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"
-                 f"{'' if result.iterations == 1 else 's'}, {verifier}, "
-                 f"seed {plan.options.seed}")
-    return "\n".join(lines)
-
-
-def write_artefacts(result: Result, directory: str | Path) -> Path:
-    out = Path(directory)
-    (out / "obligations").mkdir(parents=True, exist_ok=True)
-    (out / "result.json").write_text(json.dumps(result.to_json(), indent=2) + "\n")
-    (out / "certificate.txt").write_text(summary_text(result) + "\n")
-    for name, text in result.obligations.items():
-        (out / "obligations" / f"{name}.smt2").write_text(text)
-    if result.networks:
-        torch.save({name: network.state_dict() for name, network in result.networks.items()},
-                   out / "networks.pt")
-    return out

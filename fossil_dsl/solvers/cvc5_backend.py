@@ -2,6 +2,7 @@
 CVC5 proves is exactly what a user can re-check."""
 from __future__ import annotations
 
+import multiprocessing
 from fractions import Fraction
 from typing import Sequence
 
@@ -30,27 +31,59 @@ class Cvc5Backend:
         return self.check_text(text, timeout, variables)
 
     def check_text(self, text: str, timeout: float, variables: Sequence[str] = ()) -> Answer:
-        solver = cvc5.Solver()
-        solver.setOption("produce-models", "true")
-        solver.setOption("tlimit-per", str(max(1, int(timeout * 1000))))
-        symbols = cvc5.SymbolManager(solver.getTermManager())
-        parser = cvc5.InputParser(solver, symbols)
-        parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, _without_check_sat(text), "query")
+        """In a child process that is killed at the deadline: CVC5's nonlinear module
+        (libpoly's root isolation in its coverings procedure) was seen running for 30
+        minutes past its `tlimit-per` of 60 s, holding a benchmark run and a recheck."""
+        context = multiprocessing.get_context("fork")
+        receive, send = context.Pipe(duplex=False)
+        child = context.Process(target=_answer_into, args=(send, text, timeout, tuple(variables)))
+        child.start()
+        send.close()
         try:
-            while not (command := parser.nextCommand()).isNull():
-                command.invoke(solver, symbols)
-        except RuntimeError as exc:  # cvc5's parse and API errors
-            return Answer(Status.UNKNOWN, reason=f"CVC5 could not read the script: {exc}")
-        result = solver.checkSat()
-        if result.isUnsat():
-            return Answer(Status.UNSAT)
-        if result.isSat():
-            declared = {str(t): t for t in symbols.getDeclaredTerms()}
-            values = {v: solver.getValue(declared[v]) for v in variables if v in declared}
-            irrational = not all(value.isRealValue() for value in values.values())
-            model = {v: _rational(value) for v, value in values.items()}
-            return Answer(Status.SAT, model, approximate=irrational)
-        return Answer(Status.UNKNOWN, reason=str(result.getUnknownExplanation()))
+            if receive.poll(timeout + GRACE_SECONDS):
+                return receive.recv()
+            return Answer(Status.UNKNOWN, reason=f"timeout: CVC5 ran past {timeout:g} s "
+                          "and was stopped")
+        except EOFError:
+            return Answer(Status.UNKNOWN, reason=f"CVC5 ended without an answer "
+                          f"(exit code {child.exitcode})")
+        finally:
+            if child.is_alive():
+                child.kill()
+            child.join()
+            receive.close()
+
+
+GRACE_SECONDS = 2.0  # past the time limit, for CVC5 to stop by itself and reply
+
+
+def _answer_into(connection, text: str, timeout: float, variables) -> None:
+    connection.send(_solve(text, timeout, variables))
+    connection.close()
+
+
+def _solve(text: str, timeout: float, variables: Sequence[str]) -> Answer:
+    solver = cvc5.Solver()
+    solver.setOption("produce-models", "true")
+    solver.setOption("tlimit-per", str(max(1, int(timeout * 1000))))
+    symbols = cvc5.SymbolManager(solver.getTermManager())
+    parser = cvc5.InputParser(solver, symbols)
+    parser.setStringInput(cvc5.InputLanguage.SMT_LIB_2_6, _without_check_sat(text), "query")
+    try:
+        while not (command := parser.nextCommand()).isNull():
+            command.invoke(solver, symbols)
+    except RuntimeError as exc:  # cvc5's parse and API errors
+        return Answer(Status.UNKNOWN, reason=f"CVC5 could not read the script: {exc}")
+    result = solver.checkSat()
+    if result.isUnsat():
+        return Answer(Status.UNSAT)
+    if result.isSat():
+        declared = {str(t): t for t in symbols.getDeclaredTerms()}
+        values = {v: solver.getValue(declared[v]) for v in variables if v in declared}
+        irrational = not all(value.isRealValue() for value in values.values())
+        model = {v: _rational(value) for v, value in values.items()}
+        return Answer(Status.SAT, model, approximate=irrational)
+    return Answer(Status.UNKNOWN, reason=str(result.getUnknownExplanation()))
 
 
 NOT_IN_CVC5 = frozenset({"log", "sqrt"})

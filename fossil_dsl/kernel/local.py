@@ -1,0 +1,137 @@
+"""A function is negative near the origin, from its Taylor expansion there.
+
+The lemma (docs/certificates.md, "The ball round the origin"): let g be three times
+differentiable on the ball |x| <= ρ, with g(0) = 0, ∇g(0) = 0, x^T H x / 2 <= -μ |x|^2
+for the Hessian H of g at 0, and every third partial derivative of g bounded by M in
+absolute value on the ball. Taylor's theorem with the Lagrange remainder gives, for
+|x| <= ρ, g(x) <= -μ|x|^2 + (M/6)(|x_1| + ... + |x_n|)^3 <= -μ|x|^2 + (M/6) n^(3/2) |x|^3,
+which is negative for 0 < |x| when 36 μ^2 > M^2 n^3 ρ^2.
+
+Each hypothesis is an obligation like any other (exported, re-checked); the kernel only
+chooses μ and M, from the Hessian's eigenvalues and from the third derivatives at a few
+points, and a poor choice can only leave the lemma unproved.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from fractions import Fraction
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import traversal
+from fossil_dsl.ir.calculus import derivative
+from fossil_dsl.ir.enclosure import enclose
+from fossil_dsl.kernel.obligations import Facts, Obligation
+
+MU_SHARE = Fraction(9, 10)  # of the Hessian's margin, as μ
+M_FACTOR = 4  # the bound M over the largest third derivative seen at the probe points
+MAX_STATES = 6  # 56 third derivatives; beyond, the lemma is not tried
+
+
+def negative_near_origin(facts: Facts, name: str, g: E.Expr, words: str) -> bool:
+    """Add the lemma's obligations for g < 0 on 0 < |x| <= r (r: the claim's excluded
+    ball); False (and nothing added) where the lemma cannot apply."""
+    states, rho = facts.states, facts.r
+    if not 0 < len(states) <= MAX_STATES or rho <= 0:
+        return False
+    try:
+        if any(isinstance(v, E.Num) and v.value for v in _at_origin(g, states)):
+            return False  # not flat at the origin: the lemma cannot hold
+        hessian = _hessian_at_origin(g, states)
+        if hessian is None:
+            return False
+        mu = _margin(hessian)
+        thirds = _third_derivatives(g, states)
+        bound = _bound(thirds.values(), states, rho)
+    except (E.ExprError, ValueError, ZeroDivisionError, OverflowError):
+        return False
+    n = len(states)
+    if mu is None or bound is None or not 36 * mu ** 2 > bound ** 2 * n ** 3 * rho ** 2:
+        return False
+    _obligations(facts, name, g, words, hessian, mu, thirds, bound)
+    return True
+
+
+def _at_origin(g: E.Expr, states) -> list[E.Expr]:
+    """g and its gradient at 0."""
+    origin = {s: E.ZERO for s in states}
+    return [traversal.substitute(e, origin) for e in (g, *(derivative(g, s) for s in states))]
+
+
+def _hessian_at_origin(g: E.Expr, states) -> list[list[Fraction]] | None:
+    origin = {s: E.ZERO for s in states}
+    rows = []
+    for a in states:
+        first = derivative(g, a)
+        row = [traversal.substitute(derivative(first, b), origin) for b in states]
+        if not all(isinstance(v, E.Num) for v in row):
+            return None  # not an exact number at 0: the quadratic form is not decidable
+        rows.append([v.value for v in row])
+    return rows
+
+
+def _margin(hessian) -> Fraction | None:
+    """μ > 0 with H/2 + μ I negative definite (numerically; the obligation decides)."""
+    import numpy as np
+    largest = float(np.linalg.eigvalsh(np.array(hessian, dtype=float) / 2).max())
+    if not largest < 0:
+        return None
+    return Fraction(-largest * float(MU_SHARE)).limit_denominator(10 ** 6) or None
+
+
+def _third_derivatives(g: E.Expr, states) -> dict[tuple[int, ...], E.Expr]:
+    found = {}
+    for i, j, k in itertools.combinations_with_replacement(range(len(states)), 3):
+        found[(i, j, k)] = derivative(derivative(derivative(g, states[i]), states[j]),
+                                      states[k])
+    return found
+
+
+def _bound(thirds, states, rho: Fraction) -> Fraction | None:
+    """M: M_FACTOR times the largest |third derivative| at the origin and at ±ρ/2 on
+    each axis, rounded up to a short rational."""
+    probes = [{s: E.ZERO for s in states}]
+    for s, sign in itertools.product(states, (1, -1)):
+        probes.append({t: E.Num(sign * rho / 2) if t == s else E.ZERO for t in states})
+    largest = 0.0
+    for third in thirds:
+        for probe in probes:
+            low, high = enclose(traversal.substitute(third, probe))
+            if not math.isfinite(low) or not math.isfinite(high):
+                return None
+            largest = max(largest, abs(low), abs(high))
+    return Fraction(math.ceil(M_FACTOR * largest * 1000) + 1, 1000)
+
+
+def _obligations(facts: Facts, name, g, words, hessian, mu, thirds, bound) -> None:
+    states, rho, n = facts.states, facts.r, len(facts.states)
+    prefix = f"local:{name}"
+    at_zero = _at_origin(g, states)
+    facts.obligations.append(Obligation(
+        f"{prefix}:flat", f"{words} and its gradient are 0 at the origin",
+        L.disjunction(*(L.disjunction(L.Compare("<", v, E.ZERO), L.Compare(">", v, E.ZERO))
+                        for v in at_zero))))
+    x = [E.Var(s) for s in states]
+    form = E.add(*(E.mul(E.Num(hessian[i][j] / 2), x[i], x[j])
+                   for i in range(n) for j in range(n)),
+                 E.mul(E.Num(mu), facts.squared_norm()))
+    # both sides are quadratic forms: on the shell 1/4 <= |x|^2 <= 1 is for every x, and
+    # a bounded, strict question suits every procedure (the interval one included)
+    norm = facts.squared_norm()
+    shell = L.conjunction(L.Compare(">=", norm, E.Num(Fraction(1, 4))),
+                          L.Compare("<=", norm, E.ONE))
+    facts.obligations.append(Obligation(
+        f"{prefix}:hessian", f"x^T H x / 2 <= -{mu} |x|^2 for the Hessian H of {words} at "
+        "the origin (on 1/4 <= |x|^2 <= 1, hence everywhere)",
+        L.conjunction(shell, L.Compare(">", form, E.ZERO))))
+    ball = facts.ball(rho)
+    for (i, j, k), third in thirds.items():
+        facts.never(f"{prefix}:third:{i}{j}{k}", f"|d^3 {words}/dx{i}dx{j}dx{k}| <= {bound} on "
+                    f"the ball |x| <= {rho}", ball,
+                    L.disjunction(L.Compare(">", third, E.Num(bound)),
+                                  L.Compare("<", third, E.Num(-bound))))
+    facts.obligations.append(Obligation(
+        f"{prefix}:radius", f"36 μ^2 > M^2 n^3 ρ^2 for μ = {mu}, M = {bound}, n = {n}, "
+        f"ρ = {rho}, so {words} < 0 for 0 < |x| <= ρ",
+        L.Compare("<=", E.Num(36 * mu ** 2), E.Num(bound ** 2 * n ** 3 * rho ** 2))))

@@ -1,0 +1,39 @@
+"""What `-o DIR` writes: result.json, certificate.txt, the kernel's obligations as
+SMT-LIB 2, the networks' weights (networks.pt) and the proved formulas as ONNX models
+(certificate.onnx, controller.onnx)."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from fossil_dsl.outputs import onnx_export
+from fossil_dsl.outputs.summary import summary_text
+
+
+def write_artefacts(result: Result, directory: str | Path) -> Path:
+    out = Path(directory)
+    (out / "obligations").mkdir(parents=True, exist_ok=True)
+    (out / "result.json").write_text(json.dumps(result.to_json(), indent=2) + "\n")
+    (out / "certificate.txt").write_text(summary_text(result) + "\n")
+    for name, text in result.obligations.items():
+        (out / "obligations" / f"{name}.smt2").write_text(text)
+    write_onnx(result, out)
+    if result.networks:
+        import torch
+        torch.save({name: network.state_dict() for name, network in result.networks.items()},
+                   out / "networks.pt")
+    return out
+
+
+def write_onnx(result: Result, out: Path) -> None:
+    """certificate.onnx: one output column per function, in the certificate's order
+    (V, then B); controller.onnx: one column per input. A formula with a part ONNX has
+    no operator for gets no file (every function of the language has one today)."""
+    states = result.plan.states
+    files = {"certificate.onnx": list(result.formulas.values()),
+             "controller.onnx": list(result.controller.values())}
+    for name, formulas in files.items():
+        if formulas:
+            try:
+                onnx_export.write(formulas, states, out / name, result.plan.spec.name)
+            except onnx_export.OnnxExportError:
+                continue

@@ -1,0 +1,58 @@
+"""The text `fossilc` prints for a result: verdict, formulas, conditions, the kernel's
+side facts, guarantee, assumptions and times."""
+from __future__ import annotations
+
+
+def summary_text(result: Result) -> str:
+    plan = result.plan
+    lines = [f"{plan.spec.name}: {result.verdict.upper()} ({plan.spec.property.form}, "
+             f"{plan.certificate.title})"]
+    if not result.certified:
+        lines.append(f"  why: {result.reason}")
+    for name, formula in result.formulas.items():
+        lines.append(f"  {name}(x) = {formula}")
+    for name, formula in result.controller.items():
+        lines.append(f"  controller {name} = {formula}")
+    for name, value in result.levels.items():
+        lines.append(f"  level {name} = {value} (≈ {float(value):.6g})")
+    for report in result.conditions:
+        mark = {"unsat": "proved", "sat": "fails", "unknown": "unknown",
+                "not verified": "not verified"}[report.status]
+        if report.status == "unsat" and report.solver != plan.verifier:
+            mark += f" by {report.solver}"
+        extra = ""
+        if report.counterexample:
+            extra = " at (" + ", ".join(format(float(v), ".6g") for v in report.counterexample) + ")"
+        elif report.reason:
+            extra = f" ({report.reason})"
+        lines.append(f"  [{mark}] {report.text}{extra}")
+    lines += kernel_lines(result.kernel)
+    if result.learn_only:
+        lines.append("  learn-only: NOTHING WAS PROVED; the rates above are of fresh samples "
+                     "that violate each condition, which no verifier has checked")
+    lines.append(f"  guarantee: {result.guarantee()}")
+    if result.certified:
+        lines += [f"  assumes: {a}" for a in result.assumptions()]
+    verifier = "no verifier (learn-only)" if result.learn_only else f"verifier {plan.verifier}"
+    lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
+                 f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"
+                 f"{'' if result.iterations == 1 else 's'}, {verifier}, "
+                 f"seed {plan.options.seed}")
+    return "\n".join(lines)
+
+
+def kernel_lines(verdict: Verdict) -> list[str]:
+    """The side facts the kernel proved (the conditions are listed above them), and a
+    tally of its procedures."""
+    if not verdict.proofs:
+        return []
+    lines = [f"  [proved by {p.procedure}] {p.obligation.text}" for p in verdict.proofs
+             if p.proved and not p.obligation.name.startswith("condition:")]
+    tally: dict[str, int] = {}
+    for proof in verdict.proofs:
+        tally[proof.procedure] = tally.get(proof.procedure, 0) + proof.proved
+    used = ", ".join(f"{name} {count}" for name, count in tally.items())
+    done = sum(p.proved for p in verdict.proofs)
+    lines.append(f"  kernel: {done} of {len(verdict.proofs)} obligations proved from the "
+                 f"spec and the exact formulas ({used}) in {verdict.seconds:.2f} s")
+    return lines
