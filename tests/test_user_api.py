@@ -296,8 +296,42 @@ def test_case_study_imports_with_notes_on_what_changed(tmp_path):
     assert "VERIFIER DREAL" in run.stderr and "only the first 1 layer is built" in run.stderr
 
 
+def test_a_torus_domain_becomes_the_whole_ball_with_a_note():
+    translation = import_yaml(LISTING_1.replace("Sphere([0,0], 1.0)", "Torus([0,0], 1.0, 0.1)"))
+    assert "domain ball([0, 0], 1.0)\n" in translation.text
+    assert any("inner ball (radius 0.1) is not excluded" in n for n in translation.notes)
+    assert fossil_dsl.check_text(translation.text).ok
+
+
+SETS = {"XD": "Torus([0,0], 3.0, 0.01)", "XI": "Sphere([1,1], 0.2)",
+        "XU": "Rectangle([-1.5,1.5], [-1,2])", "XS": "Rectangle([-2,-2], [2,2])",
+        "XG": "Sphere([0,0], 0.3)", "XF": "Sphere([0,0], 0.6)"}
+NEEDS = {"Lyapunov": ["XD"], "ROA": ["XD", "XI"], "Barrier": ["XD", "XI", "XU"],
+         "BarrierAlt": ["XD", "XI", "XU"], "SWA": ["XD", "XI", "XU"],
+         "RWA": ["XD", "XI", "XS", "XG"], "RSWA": ["XD", "XI", "XS", "XG"],
+         "RAR": ["XD", "XI", "XS", "XG", "XF"]}
+
+
+@pytest.mark.parametrize("controlled", [False, True])
+@pytest.mark.parametrize("counts", ["number", "per set"])
+@pytest.mark.parametrize("certificate", sorted(NEEDS))
+def test_every_certificate_type_imports_to_a_spec_that_checks(certificate, counts,
+                                                               controlled):
+    """The reference's configs give N_DATA for every set (XU too for safe-set
+    certificates) and a Torus domain: the translation must still check."""
+    system = "[x1 + u0, -x0 - x1 + u1]" if controlled else "[x1, -x0 - x1]"
+    n_data = "N_DATA: 1000" if counts == "number" else \
+        "N_DATA:\n" + "".join(f"  {k}: 500\n" for k in SETS)
+    yaml_text = (f"SYSTEM: {system}\nCERTIFICATE: {certificate}\nTIME_DOMAIN: CONTINUOUS\n"
+                 "DOMAINS:\n" + "".join(f"  {k}: {SETS[k]}\n" for k in NEEDS[certificate])
+                 + n_data + "\nN_HIDDEN_NEURONS: [5]\nACTIVATION: [SQUARE]\n"
+                 + ("CTRLAYER: [5, 2]\nCTRLACTIVATION: [LINEAR]\n" if controlled else ""))
+    translation = import_yaml(yaml_text, "generated")
+    result = fossil_dsl.check_text(translation.text)
+    assert result.ok, translation.text + result.render()
+
+
 @pytest.mark.parametrize("shape, expected", [
-    ("Torus([0,0], 1.0, 0.1)", "ball([0, 0], 1.0) - ball([0, 0], 0.1)"),
     ("Union(Sphere([1,0], 0.5), Rectangle([-1,-1], [0,0]))",
      "(ball([1, 0], 0.5)) | (box([-1, -1], [0, 0]))"),
     ("SetMinus(Rectangle([-2,-2], [2,2]), Sphere([0,0], 0.5))",

@@ -79,10 +79,11 @@ class _Importer:
             raise YamlImportError(f"TIME_DOMAIN: {time!r} is neither CONTINUOUS nor DISCRETE")
         lines = ["# Imported from a Fossil 2.0 YAML configuration by `fossilc import-yaml`."]
         lines += spec_head(self.name, states, inputs, time, system)
+        declared = set(sets)
         lines += [f"domain {sets.pop('domain')}"] if "domain" in sets else []
         lines += [f"set {role} = {text}" for role, text in sets.items()]
         lines += ["", f"prove {prove}"]
-        options = self._synthesis(len(inputs))
+        options = self._synthesis(len(inputs), declared)
         if options:
             lines += ["", "synthesis {"] + [f"    {k}: {v}" for k, v in options] + ["}"]
         for key in self.config:
@@ -122,7 +123,8 @@ class _Importer:
                 self.notes.append(f"DOMAINS.{key}: not translated (unknown set label)")
                 continue
             try:
-                found[role] = _set_text(str(value), f"DOMAINS.{key}")
+                found[role] = self._domain_text(str(value), f"DOMAINS.{key}") \
+                    if role == "domain" else _set_text(str(value), f"DOMAINS.{key}")
             except YamlImportError as exc:
                 self.notes.append(f"DOMAINS.{key}: not translated ({exc})")
         for role in ("domain",) + roles:
@@ -131,8 +133,21 @@ class _Importer:
                                   "not give in a form that could be translated: add it")
         return found
 
+    def _domain_text(self, text: str, where: str) -> str:
+        """The reference writes a domain as a Torus to keep its verifier away from the
+        origin; a domain with a hole there cannot show stability, and makes a goal round
+        the origin leave the domain. The whole ball is the domain here (the excluded ball
+        is the verifier's business, proved apart by the kernel)."""
+        match = _CONSTRUCTOR.fullmatch(text)
+        args = _split(match.group(2)) if match else []
+        if not match or match.group(1) != "Torus" or len(args) != 3:
+            return _set_text(text, where)
+        self.notes.append(f"{where}: the Torus's inner ball (radius {args[2].strip()}) is "
+                          "not excluded: the domain is the whole ball")
+        return _set_text(f"Sphere({args[0]}, {args[1]})", where)
+
     # ---- learning ----
-    def _synthesis(self, inputs: int) -> list[tuple[str, str]]:
+    def _synthesis(self, inputs: int, declared: set[str]) -> list[tuple[str, str]]:
         options = []
         for key, alt in (("certificate", ""), ("certificate2", "_ALT")):
             layers = self._layers(f"N_HIDDEN_NEURONS{alt}", f"ACTIVATION{alt}")
@@ -141,7 +156,7 @@ class _Importer:
         controller = self._controller(inputs)
         if controller:
             options.append(("controller", controller))
-        samples = self._samples()
+        samples = self._samples(declared)
         if samples:
             options.append(("samples", samples))
         verifier = self.config.get("VERIFIER")
@@ -202,7 +217,9 @@ class _Importer:
             layers.append(f"{name}({int(width)})")
         return ", ".join(layers)
 
-    def _samples(self) -> str:
+    def _samples(self, declared: set[str]) -> str:
+        """`samples:` for the sets the spec declares; a count for a set it has not (the
+        reference's configs give XU counts for safe-set certificates) is a note."""
         data = self.config.get("N_DATA")
         if isinstance(data, int):
             return str(data)
@@ -213,6 +230,10 @@ class _Importer:
             role = SET_ROLES.get(str(key).upper())
             if role is None:
                 self.notes.append(f"N_DATA.{key}: not translated (unknown set label)")
+                continue
+            if role not in declared:
+                self.notes.append(f"N_DATA.{key}: not translated (the spec has no set "
+                                  f"`{role}`; its samples follow the sets it has)")
                 continue
             parts.append(f"{role} {int(count)}")
         return ", ".join(parts)
