@@ -19,7 +19,7 @@ from fossil_dsl.kernel.export import script
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.outputs.artefacts import write_artefacts
 from fossil_dsl.outputs.plot import phase_portrait
-from fossil_dsl.outputs.summary import summary_text
+from fossil_dsl.outputs.summary import summary_html, summary_text
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.smtlib import query_text
 
@@ -92,6 +92,10 @@ class Result:
     def summary(self) -> str:
         """The text `fossilc` prints: verdict, formulas, conditions, guarantee."""
         return summary_text(self)
+
+    def _repr_html_(self) -> str:
+        """Jupyter shows a Result as its summary and phase portrait."""
+        return summary_html(self)
 
     @property
     def sympy(self) -> dict:

@@ -2,6 +2,10 @@
 side facts, guarantee, assumptions and times."""
 from __future__ import annotations
 
+import base64
+import html
+import io
+
 
 def summary_text(result: Result) -> str:
     plan = result.plan
@@ -56,3 +60,19 @@ def kernel_lines(verdict: Verdict) -> list[str]:
     lines.append(f"  kernel: {done} of {len(verdict.proofs)} obligations proved from the "
                  f"spec and the exact formulas ({used}) in {verdict.seconds:.2f} s")
     return lines
+
+
+def summary_html(result: Result) -> str:
+    """The summary (and, for 2 and 3 states, the phase portrait) for a notebook."""
+    parts = [f"<pre>{html.escape(summary_text(result))}</pre>"]
+    if len(result.plan.states) in (2, 3):
+        import matplotlib.pyplot as plt
+        from fossil_dsl.outputs.plot import phase_portrait
+        figure = phase_portrait(result)
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format="png", dpi=80)
+        plt.close(figure)
+        picture = base64.b64encode(buffer.getvalue()).decode("ascii")
+        parts.append(f'<img alt="phase portrait of {html.escape(result.plan.spec.name)}" '
+                     f'src="data:image/png;base64,{picture}">')
+    return "\n".join(parts)
