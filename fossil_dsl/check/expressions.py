@@ -55,9 +55,10 @@ class ExpressionChecker:
             self.context.error(f"this expression has degree up to {traversal.degree(value)}; at most "
                                f"{E.MAX_DEGREE} is supported (solvers stall beyond)", node.span)
             return E.ZERO
-        extreme = next((n.value for n in E.walk(value) if isinstance(n, E.Num)
-                        and abs(n.value) > LARGEST_NUMBER), None)
-        if extreme is not None and self.where != "candidate":
+        extreme = None if self.where == "candidate" else next(
+            (n.value for n in E.walk(value)
+             if isinstance(n, E.Num) and abs(n.value) > LARGEST_NUMBER), None)
+        if extreme is not None:
             self.context.error(
                 f"the number {_magnitude_text(extreme)} is larger than the learner and the "
                 "solvers handle faithfully (magnitudes up to 1e12); rescale the units of "

@@ -134,8 +134,7 @@ def seed(plan, networks: dict[str, Network], controller: Network | None,
         return False
     operating = None
     if form in BARRIER_FORMS:  # the origin need not be an equilibrium without control
-        operating = operating_point(plan.spec) if controller is not None else \
-            (np.zeros(0) if _origin_is_an_equilibrium(plan.spec) else None)
+        operating = operating_point(plan.spec)
         if operating is None or (operating.any() and controller.zero_at_origin):
             return False
     found = local_certificate(plan.spec, controller is not None, operating)
@@ -151,14 +150,6 @@ def seed(plan, networks: dict[str, Network], controller: Network | None,
     if controller is not None:
         _set_linear(controller, -K, operating)
     return True
-
-
-def _origin_is_an_equilibrium(spec: CheckedSpec) -> bool:
-    origin = {name: E.ZERO for name in (*spec.states, *spec.inputs)}
-    try:
-        return all(abs(_value_at(f, origin)) < 1e-12 for f in spec.dynamics)
-    except (E.ExprError, ValueError, ZeroDivisionError):
-        return False
 
 
 def _barrier_level(P: np.ndarray, initial, unsafe) -> float | None:

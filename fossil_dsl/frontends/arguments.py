@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import tempfile
 from pathlib import Path
 
@@ -19,12 +20,13 @@ class OptionError(ValueError):
 
 
 def whole(value, least: int, what: str) -> int:
-    try:
-        number = int(value) if not isinstance(value, float) or value.is_integer() else None
-    except (TypeError, ValueError):
-        number = None
-    if number is None or isinstance(value, bool) or number < least or \
-            (isinstance(value, str) and value.strip() != str(number)):
+    number = None
+    if isinstance(value, str) and re.fullmatch(r"\s*-?\d+\s*", value):
+        number = int(value)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool) \
+            and float(value).is_integer():
+        number = int(value)
+    if number is None or number < least:
         raise OptionError(f"{what} must be a whole number of at least {least}, not {value!r}")
     return number
 

@@ -36,7 +36,8 @@ def negative_near_origin(facts: Facts, name: str, g: E.Expr, words: str) -> bool
     if not 0 < len(states) <= MAX_STATES or rho <= 0:
         return False
     try:
-        if any(isinstance(v, E.Num) and v.value for v in _at_origin(g, states)):
+        at_zero = _at_origin(g, states)
+        if any(isinstance(v, E.Num) and v.value for v in at_zero):
             return False  # not flat at the origin: the lemma cannot hold
         hessian = _hessian_at_origin(g, states)
         if hessian is None:
@@ -49,7 +50,7 @@ def negative_near_origin(facts: Facts, name: str, g: E.Expr, words: str) -> bool
     n = len(states)
     if mu is None or bound is None or not 36 * mu ** 2 > bound ** 2 * n ** 3 * rho ** 2:
         return False
-    _obligations(facts, name, g, words, hessian, mu, thirds, bound)
+    _obligations(facts, name, words, at_zero, hessian, mu, thirds, bound)
     return True
 
 
@@ -104,10 +105,9 @@ def _bound(thirds, states, rho: Fraction) -> Fraction | None:
     return Fraction(math.ceil(M_FACTOR * largest * 1000) + 1, 1000)
 
 
-def _obligations(facts: Facts, name, g, words, hessian, mu, thirds, bound) -> None:
+def _obligations(facts: Facts, name, words, at_zero, hessian, mu, thirds, bound) -> None:
     states, rho, n = facts.states, facts.r, len(facts.states)
     prefix = f"local:{name}"
-    at_zero = _at_origin(g, states)
     facts.obligations.append(Obligation(
         f"{prefix}:flat", f"{words} and its gradient are 0 at the origin",
         L.disjunction(*(L.disjunction(L.Compare("<", v, E.ZERO), L.Compare(">", v, E.ZERO))

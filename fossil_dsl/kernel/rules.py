@@ -206,10 +206,8 @@ SWA_GUARANTEE = ROA_GUARANTEE + ("; and those trajectories never enter U: B <= 0
                                  "B > 0 on U, and B strictly decreases wherever B = 0 in D")
 
 
-@strengthening("stable while avoid", CONTINUOUS, name="no ball left out",
-               guarantee=SWA_GUARANTEE)
-def swa_without_ball(facts: Facts) -> bool:
-    return no_ball_left_out(facts)
+strengthening("stable while avoid", CONTINUOUS, name="no ball left out",
+              guarantee=SWA_GUARANTEE)(no_ball_left_out)
 
 
 @rule("stable while avoid", guarantee=SWA_GUARANTEE)

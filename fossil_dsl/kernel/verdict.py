@@ -56,18 +56,14 @@ def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
         found, guarantee = derive_facts(claim)
     except NoRule as exc:
         return not_certified(f"the kernel cannot judge this claim: {exc}")
-    proofs = []
-    for obligation in found:
-        first = claim.procedures.get(obligation.name.removeprefix("condition:"), "")
-        proof = discharge(obligation, claim.spec.states, timeout, delta, first)
-        proofs.append(proof)
-        if not proof.proved:
-            return Verdict(False, _failure_text(proof), tuple(proofs),
-                           time.monotonic() - started)
+    proofs, proved = _prove_all(found, claim, timeout, delta)
+    if not proved:
+        return Verdict(False, _failure_text(proofs[-1]), tuple(proofs),
+                       time.monotonic() - started)
     strengthened = None
     for option, extra, stronger in derive_strengthenings(claim):
-        more = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta)
-        if more is not None:
+        more, proved = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta)
+        if proved:
             proofs += more
             guarantee, strengthened = stronger, option.name
             break
@@ -76,13 +72,16 @@ def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
 
 
 def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
-               delta: float | None) -> list[Proof] | None:
+               delta: float | None) -> tuple[list[Proof], bool]:
+    """The proofs up to the first obligation not proved, and whether all were proved.
+    The procedure that proved a condition in the run goes first (only the order)."""
     proofs = []
     for obligation in obligations:
-        proofs.append(discharge(obligation, claim.spec.states, timeout, delta))
+        first = claim.procedures.get(obligation.name.removeprefix("condition:"), "")
+        proofs.append(discharge(obligation, claim.spec.states, timeout, delta, first))
         if not proofs[-1].proved:
-            return None
-    return proofs
+            return proofs, False
+    return proofs, True
 
 
 def _failure_text(proof: Proof) -> str:

@@ -30,12 +30,10 @@ class _Graph:
         self.states = list(states)
         self.nodes, self.initialisers, self.names = [], [], {}
 
-    def constant(self, value: float, shape=()) -> str:
+    def constant(self, value: float) -> str:
         from onnx import TensorProto
         name = f"c{len(self.initialisers)}"
-        values = [value] if not shape else list(value)
-        self.initialisers.append(self.helper.make_tensor(name, TensorProto.DOUBLE, shape,
-                                                         values))
+        self.initialisers.append(self.helper.make_tensor(name, TensorProto.DOUBLE, [], [value]))
         return name
 
     def node(self, op: str, inputs: list[str], **attributes) -> str:
