@@ -95,11 +95,11 @@ CERTIFIABLE = GOOD.replace("x1 - x0^3", "-x0 + x0*x1").replace("-x0\n}", "-x1\n}
 
 
 def test_run_certifies_and_exits_0(tmp_path):
-    run = fossilc(write(tmp_path, CERTIFIABLE), "--seed", "1")
+    run = fossilc(write(tmp_path, CERTIFIABLE), "--seed", "1", "--verbose")
     assert run.returncode == 0, run.stdout + run.stderr
     assert "CERTIFIED (stability, Lyapunov function)" in run.stdout
     assert "V(x) = " in run.stdout and "guarantee: the origin is asymptotically stable" in run.stdout
-    assert "iteration   1" in run.stderr  # progress
+    assert "iteration   1" in run.stderr  # a line per iteration with --verbose
     assert_no_traceback(run)
 
 

@@ -1,21 +1,28 @@
-"""Numeric evaluation of neutral expressions and formulas on torch batches (learning and
-sampling only; nothing here proves anything)."""
+"""Numeric evaluation of neutral expressions and formulas on batches of points: torch
+tensors when learning, numpy arrays in verifier-only runs (which import no torch).
+Nothing here proves anything."""
 from __future__ import annotations
 
 import math
+import sys
+from functools import reduce
 from typing import Mapping
 
-import torch
+import numpy as np
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 
-_FUNCTIONS = {"sin": torch.sin, "cos": torch.cos, "tan": torch.tan, "exp": torch.exp,
-              "log": torch.log, "sqrt": torch.sqrt, "tanh": torch.tanh, "atan": torch.atan,
-              "abs": torch.abs}
+_NUMPY_NAMES = {"atan": "arctan"}  # where numpy's name differs from the language's
 
 
-def evaluate(expr: E.Expr, env: Mapping[str, torch.Tensor]):
+def library(value):
+    """torch or numpy, whichever `value` (an array, or a mapping of them) belongs to."""
+    torch = sys.modules.get("torch")  # loaded only by runs that learn
+    return torch if torch is not None and isinstance(value, torch.Tensor) else np
+
+
+def evaluate(expr: E.Expr, env: Mapping):
     if isinstance(expr, E.Num):
         return float(expr.value)
     if isinstance(expr, E.Var):
@@ -36,32 +43,44 @@ def evaluate(expr: E.Expr, env: Mapping[str, torch.Tensor]):
     if isinstance(expr, E.Pow):
         return evaluate(expr.base, env) ** evaluate(expr.exponent, env)
     if isinstance(expr, E.Apply):
-        value = evaluate(expr.arg, env)
-        value = value if isinstance(value, torch.Tensor) else \
-            torch.tensor(value, dtype=torch.float64)
-        return _FUNCTIONS[expr.func](value)
+        return _apply(expr.func, evaluate(expr.arg, env), env)
     raise TypeError(f"cannot evaluate {expr!r}")
 
 
-def holds(formula: L.Formula, env: Mapping[str, torch.Tensor], batch: int,
-          slack: float = 0.0) -> torch.Tensor:
+def _apply(func: str, value, env: Mapping):
+    xp = library(value if not isinstance(value, float) else next(iter(env.values()), value))
+    if xp is np:
+        return getattr(np, _NUMPY_NAMES.get(func, func))(np.asarray(value, dtype=np.float64))
+    value = value if isinstance(value, xp.Tensor) else xp.tensor(value, dtype=xp.float64)
+    return getattr(xp, func)(value)
+
+
+def holds(formula: L.Formula, env: Mapping, batch: int, slack: float = 0.0):
     """A boolean mask: where the formula holds, comparisons loosened by `slack`."""
     if isinstance(formula, L.Compare):
-        left, right = evaluate(formula.left, env), evaluate(formula.right, env)
-        difference = torch.as_tensor(left - right).expand(batch)
+        difference = _full(evaluate(formula.left, env) - evaluate(formula.right, env), env,
+                           batch)
         if formula.relation in ("<=", "<"):
             return difference <= slack if formula.relation == "<=" else difference < slack
         return difference >= -slack if formula.relation == ">=" else difference > -slack
     if isinstance(formula, L.And):
-        return torch.stack([holds(a, env, batch, slack) for a in formula.args]).all(0)
+        return reduce(lambda a, b: a & b, (holds(a, env, batch, slack) for a in formula.args))
     if isinstance(formula, L.Or):
-        return torch.stack([holds(a, env, batch, slack) for a in formula.args]).any(0)
+        return reduce(lambda a, b: a | b, (holds(a, env, batch, slack) for a in formula.args))
     if isinstance(formula, L.Not):
         return ~holds(formula.arg, env, batch, -slack)
     if isinstance(formula, L.BoolConst):
-        return torch.full((batch,), formula.value)
+        return _full(0.0, env, batch) == 0.0 if formula.value else _full(0.0, env, batch) != 0.0
     raise TypeError(f"not a formula: {formula!r}")
 
 
-def state_env(states, points: torch.Tensor) -> dict[str, torch.Tensor]:
+def _full(value, env: Mapping, batch: int):
+    """`value` (a number or an array of the batch) as an array of the batch."""
+    xp = library(value if not isinstance(value, float) else next(iter(env.values()), value))
+    if xp is np:
+        return np.broadcast_to(np.asarray(value, dtype=np.float64), (batch,))
+    return xp.as_tensor(value, dtype=xp.float64).expand(batch)
+
+
+def state_env(states, points) -> dict:
     return {name: points[:, i] for i, name in enumerate(states)}

@@ -14,6 +14,7 @@ import torch
 
 from fossil_dsl.engine import linear
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
+from fossil_dsl.engine.levels import initial_samples, level_value
 from fossil_dsl.engine.loss import GUARD_BAND, condition_loss, guard_mask, placeholders
 from fossil_dsl.engine.networks import Network, input_divisors
 from fossil_dsl.engine.sampling import box_centre, sample
@@ -47,7 +48,7 @@ class Learner(ViolationSearch):
         self.states = plan.states
         self.generator = generator
         self.box = plan.spec.domain.bounding_box()
-        self.samples = self.initial_samples()
+        self.samples = initial_samples(plan, generator)
         centre = box_centre(self.box)
         divisors = input_divisors(self.field_scales(torch.cat(list(self.samples.values()))))
         self.networks = {f.name: Network(len(self.states), f.layers, f.zero_at_origin,
@@ -89,20 +90,6 @@ class Learner(ViolationSearch):
     @property
     def trainable(self) -> bool:
         return self.optimiser is not None
-
-    # ---- samples ----
-    def initial_samples(self) -> dict[str, torch.Tensor]:
-        """Conditions over the same set with the same count share their first samples."""
-        drawn: dict[tuple[str, int], torch.Tensor] = {}
-        result = {}
-        for condition in self.plan.conditions:
-            count = self.plan.samples[condition.name]
-            key = (condition.region.text(), count)
-            if key not in drawn:
-                drawn[key] = sample(condition.region, self.states, count, self.generator,
-                                    self.box)
-            result[condition.name] = drawn[key]
-        return result
 
     # ---- values ----
     def field(self, points: torch.Tensor, open_loop: bool = False) -> list[torch.Tensor]:
@@ -172,12 +159,11 @@ class Learner(ViolationSearch):
         pushes that smallest value up, instead of dragging V and the level down
         together for ever."""
         above = self.function(level.function, self.samples[level.above])
-        if level.below is None:
-            return above.min() - 2 * self.plan.options.margin if len(above) else 0.0
-        with torch.no_grad():
-            below = self.function(level.function, self.samples[level.below])
-        low = float(above.min().detach()) if len(above) else None
-        return _between(float(below.max()) if len(below) else None, low)
+        below = None
+        if level.below is not None:
+            with torch.no_grad():
+                below = self.function(level.function, self.samples[level.below])
+        return level_value(above, below, self.plan.options.margin)
 
     # ---- loss ----
     def loss(self) -> tuple[torch.Tensor, bool]:
@@ -299,17 +285,6 @@ class Learner(ViolationSearch):
             fails = ~holds(condition.claim, env, len(points)) & considered
             rates[condition.name] = (int(fails.sum()), int(considered.sum()))
         return rates
-
-
-def _between(high: float | None, low: float | None) -> float:
-    """A level above `high` and below `low` (halfway), or just beyond the one given."""
-    if high is not None and low is not None:
-        return (high + low) / 2
-    if low is not None:
-        return low - 0.01 * (abs(low) + 1e-3)
-    if high is not None:
-        return high + 0.01 * (abs(high) + 1e-3)
-    return 0.0
 
 
 def _clip_gradients(parameters, limit: float) -> None:

@@ -7,20 +7,18 @@ formulas that are returned with it.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from typing import Callable
 
-import torch
-
-from fossil_dsl.engine.learner import Learner
+from fossil_dsl.engine.given import GivenFunctions, verifier_only
 from fossil_dsl.plan.certificates.base import change_of, level_of, value_of
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.engine.networks import Network, rational
+from fossil_dsl.ir.numbers import rational
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.api import Answer, Backend, Status
 
@@ -55,6 +53,7 @@ class CegisState:
     learn_seconds: float = 0.0
     verify_seconds: float = 0.0
     history: list[IterationRecord] = field(default_factory=list)
+    last_verified: tuple | None = None  # (candidate, queries, verdicts) of the last iteration
 
 
 @dataclass(frozen=True)
@@ -85,30 +84,64 @@ class CegisOutcome:
     history: tuple[IterationRecord, ...]
     learn_seconds: float
     verify_seconds: float
-    networks: dict[str, Network]
+    networks: dict  # name -> torch module (engine.networks.Network); none if given
+    interrupted: bool = False  # stopped by Ctrl-C: what was found so far, nothing proved
+    strategy: str = "learning"  # how the functions were found
+    refutations: dict = field(default_factory=dict)  # obligation -> sum-of-squares evidence
 
     @property
     def formulas(self) -> dict[str, E.Expr]:
         return self.candidate.formulas
 
 
-Progress = Callable[[IterationRecord], None]
+class Listener:
+    """What the loop tells while it runs (the command line's live display, say). Override
+    what you show; `progress=` of the API also takes a plain function of each record."""
+
+    def start(self, plan: Plan) -> None:
+        """Before the first iteration."""
+
+    def phase(self, iteration: int, text: str) -> None:
+        """The loop starts learning or verifying a condition (iteration 0: a step before
+        the loop, such as the sum-of-squares attempt)."""
+
+    def finished(self, record: IterationRecord) -> None:
+        """An iteration has ended."""
+
+
+class _RecordsOnly(Listener):
+    def __init__(self, function: Callable[[IterationRecord], None]):
+        self.function = function
+
+    def finished(self, record: IterationRecord) -> None:
+        self.function(record)
+
+
+def as_listener(progress: Listener | Callable | None) -> Listener:
+    if progress is None:
+        return Listener()
+    return progress if isinstance(progress, Listener) else _RecordsOnly(progress)
 
 
 class Cegis:
-    def __init__(self, plan: Plan, backend: Backend | None, progress: Progress | None = None):
+    def __init__(self, plan: Plan, backend: Backend | None,
+                 progress: Listener | Callable | None = None, deadline: float | None = None):
         self.plan = plan
         self.backend = backend
-        self.progress = progress or (lambda record: None)
+        self.listener = as_listener(progress)
         self.states = plan.states
         self.options = plan.options
+        self.learner = GivenFunctions(plan) if verifier_only(plan) else self._learner()
+        self.deadline = deadline or time.monotonic() + self.options.timeout
+
+    def _learner(self):
+        import torch  # only runs that learn import it
+        from fossil_dsl.engine.learner import Learner
         torch.manual_seed(self.options.seed)
-        self.generator = torch.Generator().manual_seed(self.options.seed)
-        self.learner = Learner(plan, self.generator)
-        self.deadline = time.monotonic() + self.options.timeout
+        return Learner(self.plan, torch.Generator().manual_seed(self.options.seed))
 
     @property
-    def networks(self) -> dict[str, Network]:
+    def networks(self) -> dict:
         found = dict(self.learner.networks)
         if self.learner.controller is not None:
             found["k"] = self.learner.controller
@@ -116,6 +149,9 @@ class Cegis:
 
     # ---- the loop ----
     def run(self) -> CegisOutcome:
+        if isinstance(self.learner, GivenFunctions):
+            return self._run()
+        import torch
         # Batches are small: a thread pool only adds waiting, and under load (another
         # process, or parallel benchmark jobs) it made steps 30x slower (60 ms, not 2 ms).
         threads = torch.get_num_threads()
@@ -127,17 +163,26 @@ class Cegis:
 
     def _run(self) -> CegisOutcome:
         state = CegisState()
+        self.listener.start(self.plan)
+        try:
+            return self._iterate(state)
+        except KeyboardInterrupt:  # Ctrl-C: what was found so far, nothing proved
+            return self._interrupted(state)
+
+    def _iterate(self, state: CegisState) -> CegisOutcome:
         reason = f"gave up after {self.options.max_iters} iterations"
         restarted = 0  # iterations before the last restart of the learner
         for state.iteration in range(1, self.options.max_iters + 1):
+            self.listener.phase(state.iteration, "learning")
             loss, learn_seconds = self.learn(state)
             candidate = self.exact_candidate()
-            verdicts, queries, verify_seconds = self.verify(candidate)
+            verdicts, queries, verify_seconds = self.verify(candidate, state.iteration)
             state.verify_seconds += verify_seconds
+            state.last_verified = (candidate, queries, verdicts)
             record = IterationRecord(state.iteration, loss, verdicts, learn_seconds,
                                      verify_seconds)
             state.history.append(record)
-            self.progress(record)
+            self.listener.finished(record)
             if all(v.status is Status.UNSAT for v in verdicts):
                 return self.outcome(state, True, "every condition proved", candidate,
                                     queries, verdicts)
@@ -156,6 +201,7 @@ class Cegis:
     def _learn_only(self) -> CegisOutcome:
         state = CegisState(iteration=1)
         loss, learn_seconds = self.learn(state)
+        import torch
         held_out = torch.Generator().manual_seed(self.options.seed + 1)
         rates = self.learner.violation_rates(held_out)
         verdicts = tuple(Verdict(name, Status.UNKNOWN, "not verified (learn-only): "
@@ -164,6 +210,14 @@ class Cegis:
         state.history.append(IterationRecord(1, loss, verdicts, learn_seconds, 0.0))
         return self.outcome(state, False, "learn-only: trained without verifying; nothing "
                             "was proved", self.exact_candidate(), {}, verdicts)
+
+    def _interrupted(self, state: CegisState) -> CegisOutcome:
+        """The last candidate verified, with its verdicts (or the networks as they are,
+        if none was verified yet)."""
+        candidate, queries, verdicts = state.last_verified or (self.exact_candidate(), {}, ())
+        outcome = self.outcome(state, False, f"interrupted (Ctrl-C) in iteration "
+                               f"{state.iteration}", candidate, queries, verdicts)
+        return replace(outcome, interrupted=True)
 
     def outcome(self, state, certified, reason, candidate, queries, verdicts):
         return CegisOutcome(certified, reason, candidate, queries, tuple(verdicts),
@@ -200,11 +254,13 @@ class Cegis:
             return E.add(calculus.compose(formula, self.states, dynamics), E.neg(formula))
         return calculus.lie_derivative(formula, self.states, dynamics)
 
-    def verify(self, candidate: ExactCandidate):
+    def verify(self, candidate: ExactCandidate, iteration: int = 0):
         started = time.monotonic()
         mapping = candidate.mapping()
         verdicts, queries = [], {}
-        for condition in self.plan.conditions:
+        total = len(self.plan.conditions)
+        for number, condition in enumerate(self.plan.conditions, 1):
+            self.listener.phase(iteration, f"verifying {condition.name} ({number}/{total})")
             query = L.substitute(self.plan.query(condition), mapping)
             queries[condition.name] = query
             budget = max(1.0, min(self.options.query_timeout, self.deadline - time.monotonic()))

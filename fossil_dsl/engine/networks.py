@@ -10,6 +10,7 @@ import torch
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir.activations import ACTIVATIONS
+from fossil_dsl.ir.numbers import rational
 from fossil_dsl.ir.spec import Layer
 
 
@@ -131,10 +132,6 @@ def input_divisors(field_scales: Sequence[float]) -> tuple[int, ...] | None:
     divisors = tuple(10 ** int(math.floor(math.log10(scale / median)))
                      if scale >= STIFF_RATIO * median else 1 for scale in field_scales)
     return divisors if any(d != 1 for d in divisors) else None
-
-
-def rational(value: float, digits: int) -> Fraction:
-    return Fraction(round(value * 10 ** digits), 10 ** digits)
 
 
 def _exact(linear: torch.nn.Linear, digits: int):

@@ -7,8 +7,8 @@ from fossil_dsl.frontends.arguments import OptionError, check_options
 from fossil_dsl.frontends.build import BespokeSet, BuildError, build_spec, spec_text
 from fossil_dsl.frontends.checking import (CheckResult, check_file, check_source, check_text,
                                            load, loads, parse)
-from fossil_dsl.engine.learner import import_optimiser_support
-from fossil_dsl.engine.loop import Cegis
+from fossil_dsl.engine.given import verifier_only
+from fossil_dsl.engine.attempts import run_attempts
 from fossil_dsl.plan.compile import Plan, compile_spec
 from fossil_dsl.kernel import Verdict, judge, not_certified
 from fossil_dsl.outputs.result import Result, build_result, claim_of
@@ -28,11 +28,13 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) ->
     rates on fresh samples, prove nothing).
     `certificate` is a Certificate subclass to use instead of the registered one."""
     options = check_options(options)  # a bad value raises OptionError before any work
-    import_optimiser_support()
-    started = time.monotonic()
     plan = compile_spec(spec, certificate=certificate, **options)
+    if not verifier_only(plan):
+        from fossil_dsl.engine.learner import import_optimiser_support
+        import_optimiser_support()
+    started = time.monotonic()
     backend = None if plan.options.learn_only else _backend(plan)
-    outcome = Cegis(plan, backend, progress).run()
+    plan, outcome = run_attempts(plan, backend, progress)
     return build_result(plan, outcome, _judge(plan, outcome), time.monotonic() - started)
 
 

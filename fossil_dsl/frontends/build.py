@@ -17,7 +17,6 @@ from fractions import Fraction
 from typing import Callable, Mapping, Sequence
 
 import sympy
-import torch
 
 from fossil_dsl.check.checker import check as check_tree
 from fossil_dsl.check.context import CheckContext
@@ -53,7 +52,7 @@ class BespokeSet:
     def constraints(self, x: Sequence[sympy.Symbol]) -> Sequence[sympy.Rel]:
         raise NotImplementedError
 
-    def sample(self, count: int, generator: torch.Generator) -> torch.Tensor:
+    def sample(self, count: int, generator: "torch.Generator") -> "torch.Tensor":
         raise NotImplementedError
 
 
@@ -204,6 +203,7 @@ def _check_agreement(spec: CheckedSpec, field: Callable) -> None:
     """The torch field must be the field the formulas state: learning on one system and
     proving another would waste the run."""
     box = spec.domain.bounding_box() or ((-1.0,) * len(spec.states), (1.0,) * len(spec.states))
+    import torch  # the field is a torch function: the caller has torch loaded already
     low, high = (torch.tensor(b, dtype=torch.float64) for b in box)
     generator = torch.Generator().manual_seed(0)
     points = low + (high - low) * torch.rand(AGREEMENT_POINTS, len(spec.states),

@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
@@ -30,6 +31,7 @@ from fossil_dsl.version import __version__
 # them: `fossilc --help` and `fossilc check` import no torch, sympy or matplotlib.
 
 EXIT_OK, EXIT_BAD_SPEC, EXIT_INTERNAL = 0, 2, 3  # 1 (not certified) comes from the result
+EXIT_INTERRUPTED = 130  # Ctrl-C, as shells report SIGINT
 
 
 def _consoles() -> tuple[Console, Console]:
@@ -78,17 +80,17 @@ def command_run(args: argparse.Namespace) -> int:
     _report(result, out, err, args.quiet or args.json, summary=not args.json)
     if not result.ok:
         return EXIT_BAD_SPEC
-    progress = None if (args.quiet or args.json) else _progress_printer(err)
     overrides = {"verifier": args.verifier, "seed": args.seed, "max_iters": args.max_iters,
                  "timeout": args.timeout, "learn_only": args.learn_only or None}
     try:
-        outcome = synthesise(result.spec, progress=progress, **overrides)
+        with _display(args, out, err) as listener:
+            outcome = synthesise(result.spec, progress=listener, **overrides)
     except (CompileError, BackendUnavailable) as exc:
         _compile_error(exc, result, err)
         return EXIT_BAD_SPEC
     if args.output:
         write_artefacts(outcome, args.output)
-    if args.plot and not _write_plots(outcome, args, err):
+    if args.plot and not outcome.interrupted and not _write_plots(outcome, args, err):
         return EXIT_BAD_SPEC
     if args.json:
         print(json.dumps(outcome.to_json(), indent=2))
@@ -117,13 +119,17 @@ def _compile_error(exc: Exception, result: CheckResult, err: Console) -> None:
     err.print(diagnostic.render(result.source), style="red", markup=False)
 
 
-def _progress_printer(err: Console):
-    def show(record) -> None:
-        failed = ", ".join(record.failed) or "none"
-        err.print(f"  iteration {record.iteration:3d}  loss {record.loss:10.3g}  "
-                  f"failed: {failed:<24}  learn {record.learn_seconds:6.2f} s  "
-                  f"verify {record.verify_seconds:6.2f} s", markup=False, style="dim")
-    return show
+def _display(args: argparse.Namespace, out: Console, err: Console):
+    """A live line on a terminal, a line per iteration with --verbose, else nothing
+    (output to a file or a pipe stays plain)."""
+    from fossil_dsl.frontends.live import IterationLines, LiveDisplay
+    if args.quiet or args.json:
+        return contextlib.nullcontext(None)
+    if args.verbose:
+        return contextlib.nullcontext(IterationLines(err))
+    if out.is_terminal and err.is_terminal:
+        return LiveDisplay(err)
+    return contextlib.nullcontext(None)
 
 
 def command_compile(args: argparse.Namespace) -> int:
@@ -172,6 +178,9 @@ def _run_parser() -> argparse.ArgumentParser:
                         help="draw the phase portrait (2- and 3-state specs) as PNG and SVG: "
                         "DIR/phase_portrait.* with -o DIR, else SPECNAME_portrait.*")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress, errors only")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="a line per CEGIS iteration (loss, failing conditions, times) "
+                        "instead of the live display")
     parser.add_argument("--json", action="store_true", help="print result.json on stdout")
     parser.add_argument("--version", action="version", version=f"fossilc {__version__}")
     parser.set_defaults(handler=command_run)
@@ -322,8 +331,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = parse_arguments(argv)
         return args.handler(args)
-    except KeyboardInterrupt:
-        return 130
+    except KeyboardInterrupt:  # outside a run's loop (which stops with a summary)
+        print("fossilc: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except Exception as exc:  # a bug in fossilc, never the user's input
         if os.environ.get("FOSSIL_DEBUG"):
             raise

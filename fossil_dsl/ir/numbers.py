@@ -1,4 +1,5 @@
-"""Exact text for rational numbers: an integer, a finite decimal, or p/q."""
+"""Exact rationals: rounding floats to decimals, and their text (an integer, a finite
+decimal, or p/q)."""
 from __future__ import annotations
 
 from fractions import Fraction
@@ -23,3 +24,8 @@ def number_text(value: Fraction) -> str:
     whole, frac = divmod(int(scaled), 10 ** digits)
     sign = "-" if value < 0 else ""
     return f"{sign}{whole}.{frac:0{digits}d}"
+
+
+def rational(value: float, digits: int) -> Fraction:
+    """`value` rounded to `digits` decimals, exactly."""
+    return Fraction(round(value * 10 ** digits), 10 ** digits)

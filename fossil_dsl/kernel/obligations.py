@@ -33,7 +33,8 @@ class Claim:
     formula), the levels ("beta") and the radius of the ball a delta-decision verifier
     left out round the origin (0: only the origin itself). `procedures` names, per
     condition, the procedure that proved it during the run: the kernel tries it first,
-    which changes only how soon it answers, never what it accepts."""
+    which changes only how soon it answers, never what it accepts. `refutations` are
+    evidence for obligations, which the kernel checks exactly before any solver."""
 
     spec: CheckedSpec
     functions: Mapping[str, E.Expr]
@@ -41,6 +42,9 @@ class Claim:
     levels: Mapping[str, Fraction] = field(default_factory=dict)
     ball_radius: Fraction = Fraction(0)
     procedures: Mapping[str, str] = field(default_factory=dict)
+    # obligation name -> a sum-of-squares refutation of its query (positivstellensatz.py),
+    # checked exactly; one that does not check is ignored and the solvers are asked
+    refutations: Mapping[str, object] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

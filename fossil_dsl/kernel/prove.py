@@ -1,6 +1,8 @@
 """Discharging one obligation with a sound procedure.
 
 - A query whose comparisons are between numbers is decided by exact rational arithmetic.
+- A query with a sum-of-squares refutation (positivstellensatz.py) that checks exactly
+  (a polynomial identity and positive semidefinite Gram matrices, in rationals) is proved.
 - Arithmetic queries (polynomials, division, integer powers, abs) go to Z3 on exact
   rationals, then to the interval procedure, then to CVC5, each with a share of the time
   (a hard nonlinear query can stall Z3 and CVC5 for minutes where the interval
@@ -26,6 +28,7 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel.obligations import Obligation
+from fossil_dsl.kernel.positivstellensatz import refutation_problem
 from fossil_dsl.solvers.api import Answer, Status
 
 
@@ -57,13 +60,18 @@ def is_arithmetic(formula: L.Formula) -> bool:
 SHARES = {"z3": 0.3, "interval": 0.5, "cvc5": 0.2}
 
 
+SUM_OF_SQUARES = "sum of squares (exact)"
+
+
 def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
-              delta: float | None = None, first: str = "") -> Proof:
+              delta: float | None = None, first: str = "", refutation=None) -> Proof:
     query = obligation.query
     exact = L.truth(query)
     if exact is not None:
         outcome = Outcome.FAILS if exact else Outcome.PROVED
         return Proof(obligation, outcome, "exact arithmetic")
+    if refutation is not None and refutation_problem(refutation, query, states) is None:
+        return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES)
     if is_arithmetic(query):
         return _arithmetic(obligation, states, timeout, delta, first)
     return _interval(obligation, states, timeout, delta)

@@ -78,7 +78,8 @@ def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
     proofs = []
     for obligation in obligations:
         first = claim.procedures.get(obligation.name.removeprefix("condition:"), "")
-        proofs.append(discharge(obligation, claim.spec.states, timeout, delta, first))
+        proofs.append(discharge(obligation, claim.spec.states, timeout, delta, first,
+                                claim.refutations.get(obligation.name)))
         if not proofs[-1].proved:
             return proofs, False
     return proofs, True

@@ -1,10 +1,14 @@
 """What `-o DIR` writes: result.json, certificate.txt, the kernel's obligations as
-SMT-LIB 2, the networks' weights (networks.pt) and the proved formulas as ONNX models
+SMT-LIB 2 (and the sum-of-squares refutations that proved some, as NAME.sos.json), the
+networks' weights (networks.pt) and the proved formulas as ONNX models
 (certificate.onnx, controller.onnx)."""
 from __future__ import annotations
 
 import json
 from pathlib import Path
+
+from fossil_dsl.kernel.obligations import file_stem
+from fossil_dsl.kernel.positivstellensatz import refutation_json
 from fossil_dsl.outputs import onnx_export
 from fossil_dsl.outputs.summary import summary_text
 
@@ -16,6 +20,9 @@ def write_artefacts(result: Result, directory: str | Path) -> Path:
     (out / "certificate.txt").write_text(summary_text(result) + "\n")
     for name, text in result.obligations.items():
         (out / "obligations" / f"{name}.smt2").write_text(text)
+    for name, refutation in result.refutations.items():
+        data = {"obligation": name, **refutation_json(refutation, result.plan.states)}
+        (out / "obligations" / f"{file_stem(name)}.sos.json").write_text(json.dumps(data) + "\n")
     write_onnx(result, out)
     if result.networks:
         import torch

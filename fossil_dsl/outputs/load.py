@@ -14,7 +14,7 @@ from fractions import Fraction
 from pathlib import Path
 
 from fossil_dsl.kernel import Claim, judge, not_certified
-from fossil_dsl.outputs.recheck import RecheckError, checked_spec, read_formulas
+from fossil_dsl.outputs.recheck import RecheckError, checked_spec, read_formulas, read_refutations
 from fossil_dsl.outputs.result import ConditionReport, Result
 from fossil_dsl.plan.compile import Plan, compile_spec
 
@@ -40,7 +40,8 @@ def load_result(directory: str | Path, judge_again: bool = True, timeout: float 
     # the procedure that proved each obligation before goes first: only the order
     procedures = {o["name"].removeprefix("condition:"): o.get("procedure", "")
                   for o in data.get("kernel", {}).get("obligations", [])}
-    claim = Claim(plan.spec, formulas, controller, levels, plan.origin_radius, procedures)
+    claim = Claim(plan.spec, formulas, controller, levels, plan.origin_radius, procedures,
+                  read_refutations(folder))
     verdict = judge(claim, timeout=timeout) if judge_again else \
         not_certified("loaded without judging (judge_again=False); result.json says "
                       f"{data.get('verdict')!r}")
@@ -51,7 +52,8 @@ def load_result(directory: str | Path, judge_again: bool = True, timeout: float 
                   _obligations(folder), int(data.get("iterations", 0)),
                   float(seconds.get("learn", 0)), float(seconds.get("verify", 0)),
                   float(seconds.get("total", 0)), int(data.get("digits", 3)),
-                  _networks(folder, plan), verdict)
+                  _networks(folder, plan), verdict, bool(data.get("interrupted", False)),
+                  str(data.get("strategy", "learning")), claim.refutations)
 
 
 def _plan(data: dict) -> Plan:

@@ -11,7 +11,7 @@ from __future__ import annotations
 from itertools import combinations
 from pathlib import Path
 
-import torch
+import numpy as np
 
 from fossil_dsl.diagnostics import FslError
 from fossil_dsl.ir import expr as E
@@ -76,7 +76,7 @@ class _Portrait:
         for (name, region), colour in zip(self._sets(), SET_COLOURS * 4):
             inside = holds(region.contains_formula(self.states),
                            state_env(self.states, grid), len(grid)).reshape(X.shape)
-            mask = inside.to(torch.float64).numpy()
+            mask = inside.astype(np.float64)
             ax.contourf(X, Y, mask, levels=[0.5, 1.5], colors=[colour], alpha=0.12)
             ax.contour(X, Y, mask, levels=[0.5], colors=[colour], linewidths=1.2)
             ax.plot([], [], color=colour, label=name)
@@ -106,8 +106,7 @@ class _Portrait:
     def _draw_functions(self, ax, grid, X, Y) -> None:
         env = state_env(self.states, grid)
         for (name, formula), colour in zip(self.result.formulas.items(), FUNCTION_COLOURS * 4):
-            values = torch.as_tensor(evaluate(formula, env), dtype=torch.float64)
-            values = values.expand(len(grid)).reshape(X.shape).numpy()
+            values = _column(evaluate(formula, env), len(grid)).reshape(X.shape)
             levels = self._levels_of(name)
             if not levels or not values.min() < max(levels) or not min(levels) < values.max():
                 levels = [0.0] if values.min() < 0 < values.max() else \
@@ -122,10 +121,10 @@ class _Portrait:
         """For a function with no level of its own (a Lyapunov V): three sublevel sets
         inside the domain."""
         inside = holds(self.spec.domain.contains_formula(self.states),
-                       state_env(self.states, grid), len(grid)).reshape(shape).numpy()
+                       state_env(self.states, grid), len(grid)).reshape(shape)
         # a hole around the origin (an annulus) is not where V leaves the domain
-        far = (grid.norm(dim=1) > 0.5 * min(h - l for l, h in zip(self.low, self.high)) / 2)
-        outside = values[~inside & far.reshape(shape).numpy()]
+        far = np.linalg.norm(grid, axis=1) > 0.5 * min(h - l for l, h in zip(self.low, self.high)) / 2
+        outside = values[~inside & far.reshape(shape)]
         top = float(outside.min()) if outside.size else float(values.max())
         return [top * f for f in (0.1, 0.4, 0.9)] if top > 0 else []
 
@@ -139,17 +138,17 @@ class _Portrait:
     # ---- numbers ----
     def _grid(self, pair, count: int):
         i, j = pair
-        xs = torch.linspace(self.low[i], self.high[i], count, dtype=torch.float64)
-        ys = torch.linspace(self.low[j], self.high[j], count, dtype=torch.float64)
-        X, Y = torch.meshgrid(xs, ys, indexing="xy")
-        grid = torch.tensor(self.centre, dtype=torch.float64).repeat(X.numel(), 1)
+        xs = np.linspace(self.low[i], self.high[i], count)
+        ys = np.linspace(self.low[j], self.high[j], count)
+        X, Y = np.meshgrid(xs, ys, indexing="xy")
+        grid = np.tile(np.asarray(self.centre, dtype=np.float64), (X.size, 1))
         grid[:, i], grid[:, j] = X.reshape(-1), Y.reshape(-1)
-        return grid, X.numpy(), Y.numpy()
+        return grid, X, Y
 
-    def _field_at(self, points: torch.Tensor) -> torch.Tensor:
+    def _field_at(self, points: np.ndarray) -> np.ndarray:
         env = state_env(self.states, points)
-        return torch.stack([torch.as_tensor(evaluate(f, env), dtype=torch.float64)
-                            .expand(len(points)) for f in self.field], 1)
+        with np.errstate(all="ignore"):  # paths that blow up are cut where they leave
+            return np.stack([_column(evaluate(f, env), len(points)) for f in self.field], 1)
 
     def _sets(self) -> list[tuple[str, object]]:
         named = dict(self.spec.sets)
@@ -158,7 +157,7 @@ class _Portrait:
 
     def _trajectories(self, seed: int) -> list:
         start_set = self.spec.property.role("initial") or self.spec.domain
-        generator = torch.Generator().manual_seed(seed)
+        generator = np.random.default_rng(seed)
         starts = sample(start_set, self.states, TRAJECTORIES, generator,
                         (self.low, self.high))
         if self.spec.time is TimeDomain.DISCRETE:
@@ -169,36 +168,43 @@ class _Portrait:
 
 def _integrate(field, starts, span: float, low, high, steps: int = 600) -> list:
     """RK4 paths, each cut where it leaves the (slightly enlarged) domain box."""
-    speed = float(field(starts).norm(dim=1).max()) or 1.0
+    speed = float(np.nan_to_num(np.linalg.norm(field(starts), axis=1)).max()) or 1.0
     dt = 4 * span / speed / steps
-    points, history = starts.clone(), [starts.clone()]
-    for _ in range(steps):
-        k1 = field(points)
-        k2 = field(points + dt / 2 * k1)
-        k3 = field(points + dt / 2 * k2)
-        k4 = field(points + dt * k3)
-        points = points + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        history.append(points.clone())
-    return _cut(torch.stack(history, 1), low, high)
+    points, history = starts.copy(), [starts.copy()]
+    with np.errstate(all="ignore"):
+        for _ in range(steps):
+            k1 = field(points)
+            k2 = field(points + dt / 2 * k1)
+            k3 = field(points + dt / 2 * k2)
+            k4 = field(points + dt * k3)
+            points = points + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            history.append(points.copy())
+    return _cut(np.stack(history, 1), low, high)
 
 
 def _iterate(step, starts, steps: int, low, high) -> list:
-    points, history = starts.clone(), [starts.clone()]
+    points, history = starts.copy(), [starts.copy()]
     for _ in range(steps):
         points = step(points)
-        history.append(points.clone())
-    return _cut(torch.stack(history, 1), low, high)
+        history.append(points.copy())
+    return _cut(np.stack(history, 1), low, high)
 
 
-def _cut(paths: torch.Tensor, low, high) -> list:
-    margin = 0.05 * (torch.tensor(high) - torch.tensor(low))
-    lo, hi = torch.tensor(low) - margin, torch.tensor(high) + margin
+def _cut(paths: np.ndarray, low, high) -> list:
+    margin = 0.05 * (np.asarray(high) - np.asarray(low))
+    lo, hi = np.asarray(low) - margin, np.asarray(high) + margin
     result = []
-    for path in paths:
-        inside = ((path >= lo) & (path <= hi)).all(1) & torch.isfinite(path).all(1)
-        stop = int(inside.to(torch.int64).cumprod(0).sum())
-        result.append(path[:max(stop, 1)].numpy())
+    with np.errstate(invalid="ignore"):
+        for path in paths:
+            inside = ((path >= lo) & (path <= hi)).all(1) & np.isfinite(path).all(1)
+            stop = int(np.cumprod(inside.astype(np.int64)).sum())
+            result.append(path[:max(stop, 1)])
     return result
+
+
+def _column(value, count: int) -> np.ndarray:
+    """A formula's value on `count` points (a constant formula gives a number)."""
+    return np.broadcast_to(np.asarray(value, dtype=np.float64), (count,)).copy()
 
 
 def _box(spec) -> tuple[list[float], list[float]]:

@@ -53,6 +53,9 @@ class Result:
     digits: int = 3  # decimals the network weights were rounded to
     networks: dict = field(default_factory=dict)  # name -> trained torch module ("k": controller)
     kernel: Verdict = field(default_factory=lambda: not_certified("not judged"))
+    interrupted: bool = False  # stopped by Ctrl-C (the shell's exit code 130)
+    strategy: str = "learning"  # how the functions were found (not part of any proof)
+    refutations: dict = field(default_factory=dict)  # obligation -> sum-of-squares evidence
 
     @property
     def verdict(self) -> str:
@@ -60,7 +63,7 @@ class Result:
 
     @property
     def exit_code(self) -> int:
-        return 0 if self.certified else 1
+        return 130 if self.interrupted else 0 if self.certified else 1
 
     @property
     def learn_only(self) -> bool:
@@ -77,7 +80,9 @@ class Result:
         if self.kernel.strengthened is None:
             found.append("the conditions are checked only inside the domain D")
         for name in dict.fromkeys(c.solver for c in self.conditions):
-            info = registry.BACKENDS[name]
+            info = registry.BACKENDS.get(name)  # none for the exact sum-of-squares check
+            if info is None:
+                continue
             if info.caveat:
                 found.append(info.caveat)
             if info.delta_decision:
@@ -136,6 +141,8 @@ class Result:
             "levels": {name: str(v) for name, v in self.levels.items()},
             "excluded_ball": str(plan.origin_radius),
             "learn_only": self.learn_only,
+            "interrupted": self.interrupted,
+            "strategy": self.strategy,
             "conditions": [_condition_json(c) for c in self.conditions],
             "kernel": kernel_json(self.kernel),
             "verifier": plan.verifier,
@@ -212,7 +219,8 @@ def claim_of(plan: Plan, outcome: CegisOutcome) -> Claim:
     candidate = outcome.candidate
     return Claim(plan.spec, dict(candidate.formulas), dict(candidate.controller),
                  dict(candidate.levels), plan.origin_radius,
-                 {v.condition: v.solver for v in outcome.verdicts if v.solver})
+                 {v.condition: v.solver for v in outcome.verdicts if v.solver},
+                 dict(outcome.refutations))
 
 
 def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
@@ -235,7 +243,8 @@ def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
                   dict(candidate.controller), dict(candidate.levels), reports,
                   obligations(plan, outcome, verdict.strengthened), len(outcome.history), outcome.learn_seconds,
                   outcome.verify_seconds, total_seconds, candidate.digits,
-                  dict(outcome.networks), verdict)
+                  dict(outcome.networks), verdict, outcome.interrupted, outcome.strategy,
+                  dict(outcome.refutations))
 
 
 def obligations(plan: Plan, outcome: CegisOutcome,

@@ -37,6 +37,7 @@ def summary_text(result: Result) -> str:
     lines.append(f"  guarantee: {result.guarantee()}")
     if result.certified:
         lines += [f"  assumes: {a}" for a in result.assumptions()]
+    lines.append(f"  found by: {result.strategy}")
     verifier = "no verifier (learn-only)" if result.learn_only else f"verifier {plan.verifier}"
     lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
                  f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"

@@ -3,6 +3,7 @@ CVC5 proves is exactly what a user can re-check."""
 from __future__ import annotations
 
 import multiprocessing
+import signal
 from fractions import Fraction
 from typing import Sequence
 
@@ -36,7 +37,10 @@ class Cvc5Backend:
         minutes past its `tlimit-per` of 60 s, holding a benchmark run and a recheck."""
         context = multiprocessing.get_context("fork")
         receive, send = context.Pipe(duplex=False)
-        child = context.Process(target=_answer_into, args=(send, text, timeout, tuple(variables)))
+        # daemon: a run stopped by Ctrl-C while this waits in a worker thread does not
+        # wait for CVC5 at exit
+        child = context.Process(target=_answer_into, args=(send, text, timeout, tuple(variables)),
+                                daemon=True)
         child.start()
         send.close()
         try:
@@ -58,6 +62,7 @@ GRACE_SECONDS = 2.0  # past the time limit, for CVC5 to stop by itself and reply
 
 
 def _answer_into(connection, text: str, timeout: float, variables) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     connection.send(_solve(text, timeout, variables))
     connection.close()
 

@@ -5,6 +5,7 @@ sound enclosure; the answer then carries `approximate=True`.
 """
 from __future__ import annotations
 
+import _thread
 import threading
 import time
 from fractions import Fraction
@@ -19,6 +20,7 @@ from fossil_dsl.ir.enclosure import bounds
 from fossil_dsl.solvers.api import Answer, Status, UnsupportedTheory
 
 STOP_POLL = 0.02  # s between looks at whether to interrupt Z3
+KEYBOARD = "interrupted from keyboard"  # Z3's reason after Ctrl-C
 
 
 class Z3Converter:
@@ -162,10 +164,15 @@ def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
     watcher = threading.Thread(target=watch, daemon=True)
     watcher.start()
     try:
-        return solver.check()
+        result = solver.check()
     finally:
         with lock:
             done.set()
+    if result == z3.unknown and solver.reason_unknown() == KEYBOARD:
+        # Z3 catches Ctrl-C itself, in whichever thread it runs: pass it on to the main
+        # thread, where the run stops with what it has
+        _thread.interrupt_main()
+    return result
 
 
 def _to_fraction(value) -> Fraction:

@@ -1,0 +1,92 @@
+"""What a run tries, in order: a sum-of-squares Lyapunov function where the system is
+polynomial (proved by sum-of-squares refutations of the kernel's obligations, or by the
+solvers like a given candidate), then the learning loop with the time left. Whatever is
+tried, the kernel judges the final formulas (and checks any refutation) alone."""
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+from fossil_dsl.engine import sos
+from fossil_dsl.engine.loop import Cegis, CegisOutcome, IterationRecord, Verdict, as_listener
+from fossil_dsl.kernel import Claim, list_obligations
+from fossil_dsl.kernel.prove import SUM_OF_SQUARES
+from fossil_dsl.plan.compile import Plan
+from fossil_dsl.solvers.api import Backend, Status
+
+SOS_SHARE = 0.25  # of the run's time, at most, for the sum-of-squares attempt
+SOS_SECONDS = 30.0  # and never more than this
+
+
+def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Plan, CegisOutcome]:
+    """The plan that was run (a found function becomes its candidate) and its outcome."""
+    listener = as_listener(progress)
+    deadline = time.monotonic() + plan.options.timeout
+    note = ""
+    if backend is not None and sos.applies(plan):
+        found, note = _sum_of_squares(plan, backend, listener, deadline)
+        if found is not None:
+            return found
+    outcome = Cegis(plan, backend, listener, deadline).run()
+    return plan, replace(outcome, strategy="learning" + (f" ({note})" if note else ""))
+
+
+def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with V given, certified outcome) or None, what happened)."""
+    listener.phase(0, "sum-of-squares program")
+    budget = min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
+    finding = sos.lyapunov(plan, time.monotonic() + budget)
+    if finding is None:
+        return None, "no sum-of-squares Lyapunov function of degree 2 or 4 on D"
+    given = replace(plan, functions=tuple(replace(f, candidate=finding.formula)
+                                          for f in plan.functions))
+    options = replace(plan.options, query_timeout=min(plan.options.query_timeout, budget))
+    cegis = Cegis(replace(given, options=options), backend, listener, deadline)
+    listener.phase(0, "sum-of-squares refutations")
+    outcome = _refuted(given, cegis, time.monotonic() + budget)
+    listener.finished(outcome.history[-1])
+    if not outcome.certified:
+        outcome = _merged(cegis.run(), outcome.refutations)
+    if not outcome.certified:
+        return None, f"the sum-of-squares V of degree {finding.degree} was not proved: " \
+            f"{outcome.reason}"
+    return (given, replace(outcome, strategy=finding.describe())), ""
+
+
+def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
+    """Sum-of-squares refutations of the kernel's obligations for the candidate, found
+    numerically and rounded (the kernel checks them exactly); certified here when they
+    settle every condition."""
+    started = time.monotonic()
+    candidate = cegis.exact_candidate()
+    claim = Claim(plan.spec, dict(candidate.formulas), {}, dict(candidate.levels),
+                  plan.origin_radius)
+    refutations = {}
+    for obligation in list_obligations(claim):
+        found = sos.refute(obligation.query, plan.states, deadline)
+        if found is not None:
+            refutations[obligation.name] = found
+    verdicts = tuple(Verdict(c.name, Status.UNSAT, solver=SUM_OF_SQUARES)
+                     if f"condition:{c.name}" in refutations
+                     else Verdict(c.name, Status.UNKNOWN, "no refutation found")
+                     for c in plan.conditions)
+    certified = all(v.status is Status.UNSAT for v in verdicts)
+    seconds = time.monotonic() - started
+    return CegisOutcome(certified, "every condition proved" if certified else
+                        "not every condition has a refutation", candidate, {}, verdicts,
+                        (IterationRecord(1, 0.0, verdicts, 0.0, seconds),), 0.0, seconds, {},
+                        refutations=refutations)
+
+
+def _merged(outcome: CegisOutcome, refutations: dict) -> CegisOutcome:
+    """The solvers' verdicts, with the conditions they did not prove settled by a
+    refutation where there is one. (A "counterexample" of a delta-decision verifier near
+    the origin is no obstacle: a refutation that checks shows there is none; where there
+    is a true one, no refutation exists.)"""
+    verdicts = tuple(replace(v, status=Status.UNSAT, solver=SUM_OF_SQUARES, reason="",
+                             counterexample=None)
+                     if v.status is not Status.UNSAT and f"condition:{v.condition}" in refutations
+                     else v for v in outcome.verdicts)
+    certified = not outcome.interrupted and all(v.status is Status.UNSAT for v in verdicts)
+    return replace(outcome, certified=certified, verdicts=verdicts, refutations=refutations,
+                   reason="every condition proved" if certified else outcome.reason)

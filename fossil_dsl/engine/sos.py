@@ -1,0 +1,265 @@
+"""Sum-of-squares programming for polynomial systems: a convex first attempt at a Lyapunov
+function, and exact refutations that the kernel checks without a solver.
+
+Lyapunov function. For x' = f(x) with f polynomial, find V(x) = z^T P z + e|x|^2 (z:
+the monomials of degree 1..d, P >= 0, trace P = 1) and the largest t with
+
+    -dV/dt - t|x|^2 = m^T Q m + sum_i s_i g_i,   Q >= 0, s_i sums of squares,
+
+where g_i >= 0 are the polynomial constraints describing the domain D (S-procedure). If
+t > 0, V > 0 and dV/dt < 0 on D away from the origin. V is rounded to rationals: a
+candidate, proved (or not) like any other.
+
+Refutation. For a kernel obligation whose query is a conjunction of polynomial
+comparisons h_j >= 0 (or > 0), find multipliers with s0 + sum_j sigma_j h_j = 0
+(kernel/positivstellensatz.py states why that proves the query unsatisfiable), round
+them to rationals, and absorb the rounding error into s0's Gram matrix exactly (an
+orthogonal projection onto the matrices that satisfy the identity). The kernel checks
+the identity and positive semidefiniteness in rational arithmetic.
+
+The programs are built and solved in sdp.py.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.kernel.positivstellensatz import (Refutation, SumOfSquares, comparisons,
+                                                  positive_semidefinite)
+from fossil_dsl.engine.sdp import Program
+from fossil_dsl.plan.compile import Plan
+
+FORMS = ("stability", "region of attraction")  # whose conditions a Lyapunov V meets on D
+DEGREES = (1, 2)  # V of degree 2, then 4 (z of degree up to d)
+MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
+V_FLOOR = Fraction(1, 1000)  # e in V = z^T P z + e|x|^2: V >= e|x|^2
+DECIMALS = 6  # kept of P's entries (trace P = 1: entries are at most 1)
+MULTIPLIER_DECIMALS = 12  # kept of a refutation's multipliers
+MIN_MARGIN = 1e-7  # t below this is numerical noise, not a decrease
+
+
+@dataclass(frozen=True)
+class SosFinding:
+    formula: E.Expr  # V, exact (rounded)
+    degree: int  # of V
+    margin: float  # t of the program
+    seconds: float
+
+    def describe(self) -> str:
+        return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}, "
+                f"decrease margin {self.margin:.3g}, {self.seconds:.2f} s")
+
+
+def applies(plan: Plan) -> bool:
+    """A polynomial autonomous ODE, a Lyapunov-type property, and no template or
+    candidate chosen by the user."""
+    spec = plan.spec
+    return (plan.certificate.form in FORMS and spec.time is TimeDomain.CONTINUOUS
+            and plan.controller is None and not spec.inputs and spec.torch_dynamics is None
+            and spec.synthesis.certificate is None and spec.synthesis.candidate is None
+            and not plan.options.learn_only and _field(plan) is not None)
+
+
+def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
+    """The first V (by degree) whose program is feasible with a positive margin, or None."""
+    started = time.monotonic()
+    field = _field(plan)
+    constraints = _domain_constraints(plan)
+    for degree in DEGREES:
+        if time.monotonic() > deadline:
+            return None
+        program = _LyapunovProgram(len(plan.states), field, constraints, degree)
+        if program.count > MAX_VARIABLES:
+            return None
+        x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
+        if x is not None and x[program.margin] > MIN_MARGIN:
+            formula = P.to_expr(program.exact_v(x), plan.states)
+            return SosFinding(formula, 2 * degree, float(x[program.margin]),
+                              time.monotonic() - started)
+    return None
+
+
+def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
+    """A refutation of the query (see the module's text), or None."""
+    try:
+        atoms = comparisons(query, states)
+    except ValueError:
+        return None
+    if not any(strict for _, strict in atoms):
+        return None
+    for low in (1, 0):
+        if time.monotonic() > deadline:
+            return None
+        program = _RefutationProgram(len(states), atoms, low)
+        if program.count > MAX_VARIABLES:
+            return None
+        x = program.solve({program.interior: -1.0}, deadline - time.monotonic())
+        found = program.exact(x) if x is not None else None
+        if found is not None:
+            return found
+    return None
+
+
+def _field(plan: Plan) -> list[P.Polynomial] | None:
+    try:
+        return [P.polynomial(f, plan.states) for f in plan.spec.dynamics]
+    except P.NotPolynomial:
+        return None
+
+
+def _domain_constraints(plan: Plan) -> list[P.Polynomial]:
+    """g with g >= 0 on D, from D's membership formula where it is a conjunction of
+    polynomial comparisons; others are left out (the program then asks for the decrease
+    on a larger set, which is stronger)."""
+    formula = plan.spec.domain.contains_formula(plan.states)
+    found = []
+    for atom in (formula.args if isinstance(formula, L.And) else (formula,)):
+        try:
+            found += [h for h, _ in comparisons(atom, plan.states)]
+        except ValueError:
+            continue
+    return found
+
+
+class _LyapunovProgram(Program):
+    def __init__(self, n: int, field: list[P.Polynomial], constraints: list[P.Polynomial],
+                 degree: int):
+        super().__init__(n)
+        self.z = P.monomials(n, 1, degree)
+        norm = _squared_norm(n)
+        self.field = field
+        # -dV/dt, part by part: the block is added with the Lie derivative of each entry
+        self.v_entries = []
+        self.blocks.append((self.count, self.z))
+        for j in range(len(self.z)):
+            for i in range(j + 1):
+                basis = {P.times(self.z[i], self.z[j]): Fraction(1 if i == j else 2)}
+                self.add_term(self.count, P.scale(P.lie_derivative(basis, field), -1))
+                self.v_entries.append((self.count, i, j))
+                self.count += 1
+        floor = P.scale(norm, V_FLOOR)
+        self.add_constant(P.scale(P.lie_derivative(floor, field), -1))
+        self.margin = self.scalar()
+        self.add_term(self.margin, P.scale(norm, -1))
+        top = max(2, max(P.degree(P.lie_derivative({P.times(a, b): Fraction(1)}, field))
+                         for a in self.z for b in self.z))
+        half = (top + 1) // 2
+        self.gram(P.monomials(n, 1, half), P.constant(-1, n))
+        for g in constraints:
+            room = (2 * half - P.degree(g)) // 2
+            if room >= 1:
+                self.gram(P.monomials(n, 1, room), P.scale(g, -1))
+        self.equalities.append(({v: 1.0 for v, i, j in self.v_entries if i == j}, 1.0))
+
+    def exact_v(self, x) -> P.Polynomial:
+        """z^T P z + e|x|^2 with P's entries rounded to DECIMALS decimals."""
+        terms = [P.scale(_squared_norm(self.n), V_FLOOR)]
+        for variable, i, j in self.v_entries:
+            weight = _decimal(x[variable], DECIMALS) * (1 if i == j else 2)
+            terms.append({P.times(self.z[i], self.z[j]): weight})
+        return P.add(*terms)
+
+
+class _RefutationProgram(Program):
+    """s0 + sum_j sigma_j h_j = 0: sigma_j SOS for non-strict h_j >= 0, constants
+    c_k >= 0 for strict h_k > 0 with sum c_k = 1; s0 = m^T (Q + tI) m with Q >= 0, and
+    t (at most 1) as large as possible, so that s0's Gram matrix survives rounding."""
+
+    def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int):
+        super().__init__(n)
+        self.atoms = atoms
+        top = max(2, max(P.degree(h) for h, _ in atoms))
+        half = (top + 1) // 2
+        self.multipliers: list = []
+        for h, strict in atoms:
+            room = (2 * half - P.degree(h)) // 2
+            if strict or room < low:
+                c = self.scalar()
+                self.add_term(c, h)
+                self.at_most.append(({c: -1.0}, 0.0))  # c >= 0
+                self.multipliers.append(("constant", c))
+            else:
+                basis = P.monomials(n, low, room)
+                self.multipliers.append(("square", basis, self.gram(basis, h)))
+        strict = [m[1] for m, (_, s) in zip(self.multipliers, atoms) if s]
+        self.equalities.append(({c: 1.0 for c in strict}, 1.0))
+        self.basis = P.monomials(n, low, half)
+        self.rest = self.gram(self.basis)
+        self.interior = self.scalar()
+        self.add_term(self.interior, {P.times(m, m): Fraction(1) for m in self.basis})
+        self.at_most.append(({self.interior: 1.0}, 1.0))
+
+    def exact(self, x) -> Refutation | None:
+        multipliers = []
+        total = {}
+        for (h, _), multiplier in zip(self.atoms, self.multipliers):
+            if multiplier[0] == "constant":
+                c = max(Fraction(0), _decimal(x[multiplier[1]], MULTIPLIER_DECIMALS))
+                multipliers.append(c)
+                total = P.add(total, P.scale(h, c))
+                continue
+            _, basis, entries = multiplier
+            square = _psd_square(basis, self.matrix(x, entries, len(basis)))
+            if square is None:
+                return None
+            multipliers.append(square)
+            total = P.add(total, P.multiply(square.polynomial(), h))
+        G = self.matrix(x, self.rest, len(self.basis)) + x[self.interior] * np.eye(len(self.basis))
+        rest = _projected(self.basis, G, P.scale(total, -1))
+        if rest is None:
+            return None
+        return Refutation(tuple(multipliers), rest)
+
+
+def _squared_norm(n: int) -> P.Polynomial:
+    return {tuple(int(k == i) * 2 for k in range(n)): Fraction(1) for i in range(n)}
+
+
+def _decimal(value: float, decimals: int) -> Fraction:
+    return Fraction(round(float(value) * 10 ** decimals), 10 ** decimals) \
+        if math.isfinite(value) else Fraction(0)
+
+
+def _psd_square(basis, G: np.ndarray) -> SumOfSquares | None:
+    """G rounded to rationals; nudged up the diagonal if rounding left it indefinite."""
+    for nudge in (0.0, 1e-10, 1e-8):
+        gram = _rational_matrix(G + nudge * np.eye(len(basis)))
+        if positive_semidefinite(gram):
+            return SumOfSquares(tuple(basis), gram)
+    return None
+
+
+def _rational_matrix(G: np.ndarray) -> tuple[tuple[Fraction, ...], ...]:
+    size = len(G)
+    rows = [[_decimal((G[i, j] + G[j, i]) / 2, MULTIPLIER_DECIMALS) for j in range(size)]
+            for i in range(size)]
+    return tuple(tuple(row) for row in rows)
+
+
+def _projected(basis, G: np.ndarray, target: P.Polynomial) -> SumOfSquares | None:
+    """The rational Gram matrix nearest to G (Frobenius) with m^T G m = target exactly,
+    if it is positive semidefinite: each entry (a, b) feeds one monomial m_a m_b, so the
+    projection spreads each monomial's residual evenly over its entries."""
+    gram = [list(row) for row in _rational_matrix(G)]
+    classes: dict[P.Monomial, list[tuple[int, int]]] = {}
+    for a, ma in enumerate(basis):
+        for b, mb in enumerate(basis):
+            classes.setdefault(P.times(ma, mb), []).append((a, b))
+    if any(monomial not in classes for monomial in target):
+        return None
+    for monomial, pairs in classes.items():
+        residual = target.get(monomial, Fraction(0)) - sum(gram[a][b] for a, b in pairs)
+        if residual:
+            share = residual / len(pairs)
+            for a, b in pairs:
+                gram[a][b] += share
+    rational = tuple(tuple(row) for row in gram)
+    return SumOfSquares(tuple(basis), rational) if positive_semidefinite(rational) else None

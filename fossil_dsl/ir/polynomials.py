@@ -1,0 +1,138 @@
+"""Exact sparse polynomials over the rationals: {exponent vector: coefficient}, built from
+neutral expressions. Used where a polynomial identity must hold exactly (the kernel's
+sum-of-squares check) and to set up sum-of-squares programs."""
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Mapping, Sequence
+
+from fossil_dsl.ir import expr as E
+
+Monomial = tuple[int, ...]
+Polynomial = dict[Monomial, Fraction]
+
+
+class NotPolynomial(ValueError):
+    pass
+
+
+def polynomial(expr: E.Expr, states: Sequence[str]) -> Polynomial:
+    """`expr` as a polynomial in `states` (raises NotPolynomial if it is not one)."""
+    n = len(states)
+    if isinstance(expr, E.Num):
+        return constant(expr.value, n)
+    if isinstance(expr, E.Var):
+        if expr.name not in states:
+            raise NotPolynomial(f"`{expr.name}` is not a state")
+        return {tuple(int(s == expr.name) for s in states): Fraction(1)}
+    if isinstance(expr, E.Add):
+        return add(*(polynomial(t, states) for t in expr.terms))
+    if isinstance(expr, E.Mul):
+        result = constant(1, n)
+        for factor in expr.factors:
+            result = multiply(result, polynomial(factor, states))
+        return result
+    if isinstance(expr, E.Neg):
+        return scale(polynomial(expr.operand, states), -1)
+    if isinstance(expr, E.Div) and isinstance(expr.denominator, E.Num) \
+            and expr.denominator.value != 0:
+        return scale(polynomial(expr.numerator, states), 1 / expr.denominator.value)
+    if isinstance(expr, E.Pow) and isinstance(expr.exponent, E.Num) \
+            and expr.exponent.value.denominator == 1 and expr.exponent.value >= 0:
+        return power(polynomial(expr.base, states), int(expr.exponent.value), n)
+    raise NotPolynomial(f"`{expr}` is not a polynomial in the states")
+
+
+def constant(value, n: int) -> Polynomial:
+    value = Fraction(value)
+    return {(0,) * n: value} if value else {}
+
+
+def add(*polynomials: Mapping[Monomial, Fraction]) -> Polynomial:
+    result: Polynomial = {}
+    for p in polynomials:
+        for monomial, coefficient in p.items():
+            total = result.get(monomial, Fraction(0)) + coefficient
+            if total:
+                result[monomial] = total
+            else:
+                result.pop(monomial, None)
+    return result
+
+
+def scale(p: Mapping[Monomial, Fraction], factor) -> Polynomial:
+    factor = Fraction(factor)
+    return {m: c * factor for m, c in p.items()} if factor else {}
+
+
+def multiply(p: Mapping[Monomial, Fraction], q: Mapping[Monomial, Fraction]) -> Polynomial:
+    result: Polynomial = {}
+    for m1, c1 in p.items():
+        for m2, c2 in q.items():
+            monomial = tuple(a + b for a, b in zip(m1, m2))
+            total = result.get(monomial, Fraction(0)) + c1 * c2
+            if total:
+                result[monomial] = total
+            else:
+                result.pop(monomial, None)
+    return result
+
+
+def power(p: Polynomial, exponent: int, n: int) -> Polynomial:
+    result = constant(1, n)
+    for _ in range(exponent):
+        result = multiply(result, p)
+    return result
+
+
+def degree(p: Mapping[Monomial, Fraction]) -> int:
+    return max((sum(m) for m in p), default=0)
+
+
+def low_degree(p: Mapping[Monomial, Fraction]) -> int:
+    """The smallest total degree of a term (0 for the zero polynomial)."""
+    return min((sum(m) for m in p), default=0)
+
+
+def monomials(n: int, low: int, high: int) -> list[Monomial]:
+    """Every exponent vector of n variables with total degree in [low, high], by degree."""
+    found: list[Monomial] = []
+    for total in range(low, high + 1):
+        found += _of_degree(n, total)
+    return found
+
+
+def _of_degree(n: int, total: int) -> list[Monomial]:
+    if n == 1:
+        return [(total,)]
+    return [(first,) + rest for first in range(total, -1, -1)
+            for rest in _of_degree(n - 1, total - first)]
+
+
+def times(m1: Monomial, m2: Monomial) -> Monomial:
+    return tuple(a + b for a, b in zip(m1, m2))
+
+
+def derivative(p: Mapping[Monomial, Fraction], index: int) -> Polynomial:
+    result: Polynomial = {}
+    for monomial, coefficient in p.items():
+        if monomial[index]:
+            lowered = monomial[:index] + (monomial[index] - 1,) + monomial[index + 1:]
+            result[lowered] = coefficient * monomial[index]
+    return result
+
+
+def lie_derivative(p: Mapping[Monomial, Fraction], field: Sequence[Polynomial]) -> Polynomial:
+    """The derivative of p along x' = field(x)."""
+    return add(*(multiply(derivative(p, i), f) for i, f in enumerate(field)))
+
+
+def to_expr(p: Mapping[Monomial, Fraction], states: Sequence[str]) -> E.Expr:
+    terms = []
+    # by degree, then x0 before x1 (x0^2 + x0*x1 + x1^2)
+    for monomial, coefficient in sorted(p.items(), key=lambda item: (-sum(item[0]),
+                                                                     [-k for k in item[0]])):
+        factors = [E.power(E.Var(s), E.Num(Fraction(k))) if k > 1 else E.Var(s)
+                   for s, k in zip(states, monomial) if k]
+        terms.append(E.mul(E.Num(coefficient), *factors))
+    return E.add(*terms) if terms else E.ZERO

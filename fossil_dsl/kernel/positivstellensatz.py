@@ -1,0 +1,166 @@
+"""An exact check of a sum-of-squares refutation of an obligation: no solver, only
+rational arithmetic.
+
+The obligation's query must be a conjunction of polynomial comparisons; each is read as
+h_j(x) >= 0 or h_j(x) > 0 (h_j: one side minus the other). A refutation gives, in the
+query's order, a multiplier for each comparison: none, a rational constant c >= 0, or a
+sum of squares m(x)^T G m(x) (G rational and positive semidefinite); and a sum of
+squares s0. It refutes the query when
+
+    s0(x) + sum_j sigma_j(x) h_j(x) = 0 for every x  (every coefficient cancels exactly)
+
+and some strict comparison h_k > 0 has a constant multiplier c_k > 0. At a point where
+the query held, every term would be >= 0 with sum 0, so every term 0; but c_k h_k > 0.
+So no point satisfies the query, and the obligation holds.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Sequence
+
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.expr import add, neg
+
+
+@dataclass(frozen=True)
+class SumOfSquares:
+    """m(x)^T G m(x): monomials as exponent vectors, G as rows of rationals."""
+
+    monomials: tuple[P.Monomial, ...]
+    gram: tuple[tuple[Fraction, ...], ...]
+
+    def polynomial(self) -> P.Polynomial:
+        terms: P.Polynomial = {}
+        for a, row in zip(self.monomials, self.gram):
+            for b, entry in zip(self.monomials, row):
+                if entry:
+                    terms = P.add(terms, {P.times(a, b): entry})
+        return terms
+
+
+Multiplier = Fraction | SumOfSquares | None
+
+
+@dataclass(frozen=True)
+class Refutation:
+    multipliers: tuple[Multiplier, ...]  # one per comparison of the query, in order
+    rest: SumOfSquares  # s0
+
+
+def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynomial, bool]]:
+    """(h, strict) for each comparison h >= 0 / h > 0 of a conjunctive query; raises
+    ValueError where the query is not a conjunction of polynomial comparisons."""
+    found = []
+    for atom in _conjuncts(query):
+        if isinstance(atom, L.Not) and isinstance(atom.arg, L.Compare):
+            inner = atom.arg
+            atom = L.Compare(NEGATED[inner.relation], inner.left, inner.right)
+        if not isinstance(atom, L.Compare):
+            raise ValueError(f"not a comparison: {atom}")
+        larger, smaller = (atom.left, atom.right) if atom.relation in (">", ">=") \
+            else (atom.right, atom.left)
+        found.append((P.polynomial(add(larger, neg(smaller)), states),
+                      atom.relation in ("<", ">")))
+    return found
+
+
+NEGATED = {"<": ">=", "<=": ">", ">": "<=", ">=": "<"}
+
+
+def _conjuncts(query: L.Formula) -> list[L.Formula]:
+    if isinstance(query, L.And):
+        return [atom for arg in query.args for atom in _conjuncts(arg)]
+    return [query]
+
+
+def refutation_problem(refutation: Refutation, query: L.Formula,
+                       states: Sequence[str]) -> str | None:
+    """None if the refutation proves the query unsatisfiable; else what is wrong."""
+    try:
+        atoms = comparisons(query, states)
+    except ValueError as exc:  # NotPolynomial is a ValueError too
+        return f"the query is not a conjunction of polynomial comparisons ({exc})"
+    if len(refutation.multipliers) != len(atoms):
+        return f"{len(refutation.multipliers)} multipliers for {len(atoms)} comparisons"
+    squares = [refutation.rest] + [m for m in refutation.multipliers
+                                   if isinstance(m, SumOfSquares)]
+    if not all(positive_semidefinite(s.gram) for s in squares):
+        return "a Gram matrix is not positive semidefinite"
+    total = refutation.rest.polynomial()
+    strict = False
+    for (h, is_strict), multiplier in zip(atoms, refutation.multipliers):
+        if multiplier is None:
+            continue
+        if isinstance(multiplier, SumOfSquares):
+            total = P.add(total, P.multiply(multiplier.polynomial(), h))
+            continue
+        if multiplier < 0:
+            return "a constant multiplier is negative"
+        total = P.add(total, P.scale(h, multiplier))
+        strict = strict or (is_strict and multiplier > 0)
+    if not strict:
+        return "no strict comparison has a positive constant multiplier"
+    if total:
+        return f"the identity fails: {len(total)} coefficients do not cancel"
+    return None
+
+
+def positive_semidefinite(gram: Sequence[Sequence[Fraction]]) -> bool:
+    """Exactly, by symmetric Gaussian elimination (LDL^T): no negative pivot, and a zero
+    pivot only with a zero row."""
+    n = len(gram)
+    a = [[Fraction(v) for v in row] for row in gram]
+    if any(len(row) != n for row in a) or any(a[i][j] != a[j][i]
+                                              for i in range(n) for j in range(i)):
+        return False
+    for k in range(n):
+        pivot = a[k][k]
+        if pivot < 0:
+            return False
+        if pivot == 0:
+            if any(a[k][j] for j in range(k + 1, n)):
+                return False
+            continue
+        for i in range(k + 1, n):
+            if a[i][k]:
+                ratio = a[i][k] / pivot
+                for j in range(k + 1, n):
+                    a[i][j] -= ratio * a[k][j]
+    return True
+
+
+# ---- the exported form (obligations/NAME.sos.json), which anyone can check again ----
+def refutation_json(refutation: Refutation, states: Sequence[str]) -> dict:
+    return {"states": list(states),
+            "multipliers": [_multiplier_json(m) for m in refutation.multipliers],
+            "rest": _square_json(refutation.rest)}
+
+
+def refutation_from_json(data: dict) -> Refutation:
+    """Raises ValueError (or KeyError, TypeError) where the data is malformed."""
+    return Refutation(tuple(_multiplier(m) for m in data["multipliers"]),
+                      _square(data["rest"]))
+
+
+def _multiplier_json(multiplier: Multiplier):
+    if multiplier is None or isinstance(multiplier, SumOfSquares):
+        return None if multiplier is None else _square_json(multiplier)
+    return str(multiplier)
+
+
+def _square_json(square: SumOfSquares) -> dict:
+    return {"monomials": [list(m) for m in square.monomials],
+            "gram": [[str(v) for v in row] for row in square.gram]}
+
+
+def _multiplier(data) -> Multiplier:
+    if data is None:
+        return None
+    return _square(data) if isinstance(data, dict) else Fraction(data)
+
+
+def _square(data: dict) -> SumOfSquares:
+    return SumOfSquares(tuple(tuple(int(k) for k in m) for m in data["monomials"]),
+                        tuple(tuple(Fraction(v) for v in row) for row in data["gram"]))

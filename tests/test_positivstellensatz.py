@@ -1,0 +1,93 @@
+"""The kernel's exact check of sum-of-squares refutations: what it accepts is a proof,
+and nothing forged, rounded or tampered gets through."""
+from fractions import Fraction as F
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fossil_dsl.engine import sos
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.kernel.positivstellensatz import (Refutation, SumOfSquares, positive_semidefinite,
+                                                  refutation_from_json, refutation_json,
+                                                  refutation_problem)
+
+X, Y = E.Var("x"), E.Var("y")
+STATES = ("x", "y")
+
+
+def sq(e):
+    return E.power(e, E.Num(F(2)))
+
+
+NORM = E.add(sq(X), sq(Y))
+# x in the unit disc, x != 0, and V = x^2 + y^2 <= 0: unsatisfiable
+QUERY = L.conjunction(L.Compare("<=", NORM, E.Num(F(1))), L.Compare(">", NORM, E.ZERO),
+                      L.negation(L.Compare(">", NORM, E.ZERO)))
+# s0 = 0, multipliers: none for the disc, 1 for |x|^2 > 0, 1 for -(x^2+y^2) >= 0
+ZERO_SQUARE = SumOfSquares(((1, 0), (0, 1)), ((F(0), F(0)), (F(0), F(0))))
+HAND_MADE = Refutation((None, F(1), F(1)), ZERO_SQUARE)
+
+
+def test_a_hand_made_refutation_is_accepted():
+    assert refutation_problem(HAND_MADE, QUERY, STATES) is None
+
+
+@pytest.mark.parametrize("forged, complaint", [
+    (Refutation((None, F(1)), ZERO_SQUARE), "multipliers for 3"),
+    (Refutation((None, F(1), F(2)), ZERO_SQUARE), "identity fails"),
+    (Refutation((None, F(0), F(1)), ZERO_SQUARE), "no strict comparison"),
+    (Refutation((None, F(-1), F(1)), ZERO_SQUARE), "negative"),
+    (Refutation((None, F(1), F(1)), SumOfSquares(((1, 0), (0, 1)), ((F(-1), F(0)), (F(0), F(1))))),
+     "not positive semidefinite"),
+])
+def test_forged_refutations_are_rejected(forged, complaint):
+    assert complaint in refutation_problem(forged, QUERY, STATES)
+
+
+def test_a_satisfiable_query_has_no_refutation_and_a_borrowed_one_fails():
+    satisfiable = L.conjunction(L.Compare("<=", NORM, E.Num(F(1))), L.Compare(">", NORM, E.ZERO),
+                                L.Compare(">=", X, E.ZERO))
+    import time
+    assert sos.refute(satisfiable, STATES, time.monotonic() + 10) is None
+    assert refutation_problem(HAND_MADE, satisfiable, STATES) is not None
+
+
+def test_the_engine_finds_a_refutation_the_kernel_accepts_and_its_file_form_round_trips():
+    # dV/dt of V = x^2 + y^2 along x' = -x + x*y, y' = -y, on the unit disc
+    x_dot, y_dot = E.add(E.neg(X), E.mul(X, Y)), E.neg(Y)
+    change = E.add(E.mul(E.Num(F(2)), X, x_dot), E.mul(E.Num(F(2)), Y, y_dot))
+    query = L.conjunction(L.Compare("<=", NORM, E.Num(F(1))), L.Compare(">", NORM, E.ZERO),
+                          L.negation(L.Compare("<", change, E.ZERO)))
+    import time
+    found = sos.refute(query, STATES, time.monotonic() + 30)
+    assert found is not None and refutation_problem(found, query, STATES) is None
+    again = refutation_from_json(refutation_json(found, STATES))
+    assert again == found
+    # the same refutation for a larger disc (where the claim is false: at (1.5, 1.4),
+    # dV/dt > 0) does not check
+    wider = L.conjunction(L.Compare("<=", NORM, E.Num(F(9))), L.Compare(">", NORM, E.ZERO),
+                          L.negation(L.Compare("<", change, E.ZERO)))
+    assert refutation_problem(found, wider, STATES) is not None
+
+
+small = st.integers(-5, 5).map(F)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.lists(small, min_size=3, max_size=3), min_size=1, max_size=4))
+def test_gram_products_are_positive_semidefinite(rows):
+    """A^T A is PSD; subtracting more than its trace from a diagonal entry is not."""
+    gram = [[sum(r[i] * r[j] for r in rows) for j in range(3)] for i in range(3)]
+    assert positive_semidefinite(gram)
+    trace = sum(gram[i][i] for i in range(3))
+    broken = [row[:] for row in gram]
+    broken[1][1] -= trace + 1
+    assert not positive_semidefinite(broken)
+
+
+def test_semidefinite_with_a_zero_pivot_and_asymmetric_matrices():
+    assert positive_semidefinite([[F(0), F(0)], [F(0), F(1)]])
+    assert not positive_semidefinite([[F(0), F(1)], [F(1), F(1)]])  # x^2 + 2xy... indefinite
+    assert not positive_semidefinite([[F(1), F(0)], [F(1), F(1)]])  # not symmetric

@@ -1,0 +1,128 @@
+"""The sum-of-squares first attempt: a Lyapunov function for polynomial systems from a
+semidefinite program (Clarabel), rounded to rationals and proved like any candidate."""
+import time
+
+import pytest
+import sympy
+
+import fossil_dsl
+from fossil_dsl.engine import sos
+from fossil_dsl.plan.compile import compile_spec
+
+# Khalil's Example 4.? style: a polynomial system with a cubic coupling, 3 states
+THREE_STATES = """\
+state x, y, z
+dynamics continuous {
+    x' = -x + y*z - x^3
+    y' = -2*y - x*z
+    z' = -z + x*y - z^3
+}
+domain ball([0, 0, 0], 2)
+prove stable
+"""
+
+ROA = """\
+state x, y
+dynamics continuous {
+    x' = -x + x*y
+    y' = -y + x^2
+}
+domain box([-0.8, -0.8], [0.8, 0.8])
+set I = ball([0.2, 0.1], 0.1)
+prove from I: stable
+"""
+
+
+def _plan(text: str, **options):
+    return compile_spec(fossil_dsl.loads(text), **options)
+
+
+def test_a_polynomial_system_is_certified_by_sum_of_squares_without_learning():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(THREE_STATES), timeout=120)
+    assert result.certified and result.kernel.certified
+    assert result.strategy.startswith("sum-of-squares programming")
+    assert result.learn_seconds < 0.01 and result.networks == {}
+    V = result.sympy["V"]
+    x, y, z = sorted(V.free_symbols, key=str)
+    assert sympy.Poly(V, x, y, z).total_degree() in (2, 4)
+    assert "found by: sum-of-squares" in result.summary()
+
+
+def test_region_of_attraction_takes_the_sos_function_and_a_sampled_level():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(ROA), timeout=120)
+    assert result.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares")
+    assert "beta" in result.levels
+
+
+def test_the_program_is_infeasible_for_an_unstable_system():
+    unstable = THREE_STATES.replace("x' = -x + y*z - x^3", "x' = x + y*z")
+    plan = _plan(unstable)
+    assert sos.applies(plan)
+    assert sos.lyapunov(plan, time.monotonic() + 30) is None
+    result = fossil_dsl.synthesise(fossil_dsl.loads(unstable), max_iters=1, timeout=60)
+    assert not result.certified
+    assert result.strategy.startswith("learning (no sum-of-squares")
+
+
+@pytest.mark.parametrize("change, why", [
+    (("x' = -x + y*z - x^3", "x' = -sin(x) + y*z"), "not polynomial"),
+    (("prove stable", "prove stable\nsynthesis {\n    certificate: square(4)\n}"),
+     "the user chose a template"),
+    (("prove stable", "prove stable\nsynthesis {\n    candidate: x^2 + y^2 + z^2\n}"),
+     "the user gave a candidate"),
+])
+def test_the_attempt_is_skipped_where_it_does_not_apply(change, why):
+    assert not sos.applies(_plan(THREE_STATES.replace(*change))), why
+
+
+def test_the_found_function_is_rounded_to_rationals_and_positive_definite():
+    plan = _plan(THREE_STATES)
+    finding = sos.lyapunov(plan, time.monotonic() + 30)
+    assert finding is not None and finding.margin > 0
+    from fossil_dsl.ir.symbolic import to_sympy
+    V = to_sympy(finding.formula)
+    assert all(isinstance(c, sympy.Rational) for c in sympy.Poly(V).coeffs())
+    x, y, z = sorted(V.free_symbols, key=str)
+    hessian = sympy.hessian(V, (x, y, z)).subs({x: 0, y: 0, z: 0})
+    assert all(value > 0 for value in hessian.eigenvals())
+
+
+RING_6 = """\
+state a, b, c, d, e, f
+dynamics continuous {
+    a' = -a + 0.4*b - a^3
+    b' = -b + 0.4*c - b^3
+    c' = -c + 0.4*d - c^3
+    d' = -d + 0.4*e - d^3
+    e' = -e + 0.4*f - e^3
+    f' = -f + 0.4*a - f^3
+}
+domain ball([0, 0, 0, 0, 0, 0], 1)
+prove stable
+"""
+
+
+def test_six_states_are_proved_by_refutations_that_export_recheck_and_load(tmp_path):
+    """The kernel proves the conditions from sum-of-squares refutations (checked
+    exactly), writes them next to the SMT-LIB files, recheck checks them again, and a
+    tampered one is not accepted when the result is loaded."""
+    import json
+    from fossil_dsl.outputs.recheck import recheck
+    result = fossil_dsl.synthesise(fossil_dsl.loads(RING_6), timeout=120)
+    assert result.certified, result.summary()
+    procedures = {p.obligation.name: p.procedure for p in result.kernel.proofs}
+    assert procedures["condition:decrease"] == "sum of squares (exact)"
+    result.save(tmp_path)
+    exported = tmp_path / "obligations" / "condition-decrease.sos.json"
+    assert exported.exists()
+    checks = {c.condition: c for c in recheck(tmp_path, timeout=5)}
+    assert checks["condition-decrease"].reproved
+    assert checks["condition-decrease"].solver.startswith("sum of squares")
+    assert fossil_dsl.load_result(tmp_path).certified
+    data = json.loads(exported.read_text())
+    data["rest"]["gram"][0][0] = str(-1)  # no longer positive semidefinite
+    exported.write_text(json.dumps(data))
+    again = fossil_dsl.load_result(tmp_path, timeout=2)
+    decrease = [p for p in again.kernel.proofs if p.obligation.name == "condition:decrease"]
+    assert not decrease or decrease[0].procedure != "sum of squares (exact)"
