@@ -71,7 +71,9 @@ def test_certificate_is_exact_and_reported(tmp_path):
     assert data["verdict"] == "certified"
     assert data["functions"]["V"] == str(result.formulas["V"])
     assert "asymptotically stable" in data["guarantee"]
-    assert any("rounded" in a for a in data["assumptions"])
+    # a learned network states its rounding; a sum-of-squares V has no weights to round
+    rounded = any("rounded" in a for a in data["assumptions"])
+    assert rounded == (data["strategy"] == "learning" or data["strategy"].startswith("learning "))
     assert "V(x) = " in (tmp_path / "certificate.txt").read_text()
 
 

@@ -91,3 +91,16 @@ def test_semidefinite_with_a_zero_pivot_and_asymmetric_matrices():
     assert positive_semidefinite([[F(0), F(0)], [F(0), F(1)]])
     assert not positive_semidefinite([[F(0), F(1)], [F(1), F(1)]])  # x^2 + 2xy... indefinite
     assert not positive_semidefinite([[F(1), F(0)], [F(1), F(1)]])  # not symmetric
+
+
+def test_a_power_of_a_strict_comparison_refutes_and_round_trips():
+    """|x|^2 > 0 and -(|x|^2)^2 >= 0: the term 1 * (|x|^2)^2 cancels the second."""
+    from fossil_dsl.kernel.positivstellensatz import Power
+    query = L.conjunction(L.Compare(">", NORM, E.ZERO),
+                          L.Compare(">=", E.neg(E.power(NORM, E.Num(F(2)))), E.ZERO))
+    good = Refutation((Power(F(1), 2), F(1)), ZERO_SQUARE)
+    assert refutation_problem(good, query, STATES) is None
+    assert refutation_from_json(refutation_json(good, STATES)) == good
+    assert "power is below 1" in refutation_problem(Refutation((Power(F(1), 0), F(1)), ZERO_SQUARE),
+                                                     query, STATES)
+    assert refutation_problem(Refutation((F(1), F(1)), ZERO_SQUARE), query, STATES) is not None

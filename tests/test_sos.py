@@ -126,3 +126,53 @@ def test_six_states_are_proved_by_refutations_that_export_recheck_and_load(tmp_p
     again = fossil_dsl.load_result(tmp_path, timeout=2)
     decrease = [p for p in again.kernel.proofs if p.obligation.name == "condition:decrease"]
     assert not decrease or decrease[0].procedure != "sum of squares (exact)"
+
+
+MARGINAL = """\
+state x0, x1
+dynamics continuous {
+    x0' = -x0^3 + x1
+    x1' = -x0 - x1^3
+}
+domain ball([0, 0], 1)
+prove stable
+"""
+
+
+def test_a_marginally_stable_linearisation_is_proved_with_a_quartic_decrease():
+    """The linearisation is a centre: no t|x|^2 decrease exists, t|x|^4 does, and the
+    refutations use the strict comparison |x|^2 > 0 squared."""
+    result = fossil_dsl.synthesise(fossil_dsl.loads(MARGINAL), timeout=60)
+    assert result.certified, result.summary()
+    assert "|x|^4" in result.strategy
+    procedures = {p.obligation.name: p.procedure for p in result.kernel.proofs}
+    assert procedures["condition:decrease"] == "sum of squares (exact)"
+
+
+def test_a_region_of_attraction_gets_a_round_enough_v():
+    """The Lorenz system below its bifurcation: the V of largest margin is too flat for
+    a sublevel set between init and the domain's boundary; the roundest V with a quarter
+    of that margin fits."""
+    from pathlib import Path
+    spec = fossil_dsl.load(Path(__file__).resolve().parent.parent / "specs" / "literature"
+                           / "lit24_lorenz_subcritical_roa.fsl")
+    result = fossil_dsl.synthesise(spec, timeout=60)
+    assert result.certified and result.strategy.startswith("sum-of-squares")
+
+
+HENON_LIKE = """\
+state x0, x1
+dynamics discrete {
+    next(x0) = 0.4*x0 - 0.3*x1 + 0.2*x0*x1
+    next(x1) = 0.5*x0 + 0.3*x1 - 0.1*x0^2
+}
+domain ball([0, 0], 1)
+prove stable
+"""
+
+
+def test_a_polynomial_map_gets_a_sum_of_squares_v_too():
+    """V(f(x)) - V(x) takes dV/dt's place; the kernel's discrete rule judges it."""
+    result = fossil_dsl.synthesise(fossil_dsl.loads(HENON_LIKE), timeout=60)
+    assert result.certified, result.summary()
+    assert "V(f(x)) - V(x) <= -" in result.strategy

@@ -29,17 +29,19 @@ class Program:
         self.equalities: list[tuple[dict[int, float], float]] = []
         self.at_most: list[tuple[dict[int, float], float]] = []  # coefficients . x <= bound
 
-    def gram(self, basis: list[P.Monomial], times: P.Polynomial | None = None):
-        """A PSD block G over the basis, adding (m^T G m) * times to the identity;
-        returns [(variable, i, j)] for its upper triangle, column by column."""
+    def gram(self, basis: list[P.Monomial], times: P.Polynomial | None = None,
+             in_identity: bool = True):
+        """A PSD block G over the basis, adding (m^T G m) * times to the identity (unless
+        not `in_identity`); returns [(variable, i, j)] for its upper triangle, column by
+        column."""
         times = times or P.constant(1, self.n)
         self.blocks.append((self.count, basis))
         entries = []
         for j in range(len(basis)):
             for i in range(j + 1):
-                weight = 1 if i == j else 2
-                product = {P.times(basis[i], basis[j]): Fraction(weight)}
-                self.add_term(self.count, P.multiply(product, times))
+                if in_identity:
+                    product = {P.times(basis[i], basis[j]): Fraction(1 if i == j else 2)}
+                    self.add_term(self.count, P.multiply(product, times))
                 entries.append((self.count, i, j))
                 self.count += 1
         return entries

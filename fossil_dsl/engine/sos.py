@@ -7,8 +7,9 @@ the monomials of degree 1..d, P >= 0, trace P = 1) and the largest t with
     -dV/dt - t|x|^2 = m^T Q m + sum_i s_i g_i,   Q >= 0, s_i sums of squares,
 
 where g_i >= 0 are the polynomial constraints describing the domain D (S-procedure). If
-t > 0, V > 0 and dV/dt < 0 on D away from the origin. V is rounded to rationals: a
-candidate, proved (or not) like any other.
+t > 0, V > 0 and dV/dt < 0 on D away from the origin. For a map x+ = f(x), V(f(x)) - V(x)
+takes the place of dV/dt. V is rounded to rationals: a candidate, proved (or not) like
+any other.
 
 Refutation. For a kernel obligation whose query is a conjunction of polynomial
 comparisons h_j >= 0 (or > 0), find multipliers with s0 + sum_j sigma_j h_j = 0
@@ -32,7 +33,7 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.kernel.positivstellensatz import (Refutation, SumOfSquares, comparisons,
+from fossil_dsl.kernel.positivstellensatz import (Power, Refutation, SumOfSquares, comparisons,
                                                   positive_semidefinite)
 from fossil_dsl.engine.sdp import Program
 from fossil_dsl.plan.compile import Plan
@@ -44,6 +45,10 @@ V_FLOOR = Fraction(1, 1000)  # e in V = z^T P z + e|x|^2: V >= e|x|^2
 DECIMALS = 6  # kept of P's entries (trace P = 1: entries are at most 1)
 MULTIPLIER_DECIMALS = 12  # kept of a refutation's multipliers
 MIN_MARGIN = 1e-7  # t below this is numerical noise, not a decrease
+# the decrease asked for: t|x|^2, else t|x|^4 (where the linearisation is only marginally
+# stable, as for x' = -x^3 + y, y' = -x - y^3); a refutation likewise uses c h or c h^2
+# for a strict comparison h > 0
+MARGIN_POWERS = (1, 2)
 
 
 @dataclass(frozen=True)
@@ -51,19 +56,21 @@ class SosFinding:
     formula: E.Expr  # V, exact (rounded)
     degree: int  # of V
     margin: float  # t of the program
+    power: int  # dV/dt <= -t |x|^(2 power)
     seconds: float
+    change: str = "dV/dt"  # or V(f(x)) - V(x)
 
     def describe(self) -> str:
         return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}, "
-                f"decrease margin {self.margin:.3g}, {self.seconds:.2f} s")
+                f"{self.change} <= -{self.margin:.3g} |x|^{2 * self.power} on D, "
+                f"{self.seconds:.2f} s")
 
 
 def applies(plan: Plan) -> bool:
     """A polynomial autonomous ODE, a Lyapunov-type property, and no template or
     candidate chosen by the user."""
     spec = plan.spec
-    return (plan.certificate.form in FORMS and spec.time is TimeDomain.CONTINUOUS
-            and plan.controller is None and not spec.inputs and spec.torch_dynamics is None
+    return (plan.certificate.form in FORMS and plan.controller is None and not spec.inputs and spec.torch_dynamics is None
             and spec.synthesis.certificate is None and spec.synthesis.candidate is None
             and not plan.options.learn_only and _field(plan) is not None)
 
@@ -73,18 +80,34 @@ def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
     started = time.monotonic()
     field = _field(plan)
     constraints = _domain_constraints(plan)
-    for degree in DEGREES:
+    for degree, power in ((d, m) for d in DEGREES for m in MARGIN_POWERS):
         if time.monotonic() > deadline:
             return None
-        program = _LyapunovProgram(len(plan.states), field, constraints, degree)
+        program = _LyapunovProgram(len(plan.states), field, constraints, degree, power,
+                                   plan.spec.time is TimeDomain.DISCRETE)
         if program.count > MAX_VARIABLES:
             return None
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
-        if x is not None and x[program.margin] > MIN_MARGIN:
-            formula = P.to_expr(program.exact_v(x), plan.states)
-            return SosFinding(formula, 2 * degree, float(x[program.margin]),
-                              time.monotonic() - started)
+        if x is None or x[program.margin] <= MIN_MARGIN:
+            continue
+        margin = float(x[program.margin])
+        if plan.certificate.form == "region of attraction":
+            rounder = _roundest(program, margin, deadline)
+            x = rounder if rounder is not None else x
+        formula = P.to_expr(program.exact_v(x), plan.states)
+        return SosFinding(formula, 2 * degree, float(x[program.margin]), power,
+                          time.monotonic() - started,
+                          "V(f(x)) - V(x)" if program.discrete else "dV/dt")
     return None
+
+
+def _roundest(program: "_LyapunovProgram", margin: float, deadline: float):
+    """The V whose quadratic part is roundest (largest smallest eigenvalue, trace 1),
+    keeping a quarter of the best margin: a region of attraction needs a sublevel set
+    that holds the initial set and fits in D, which a V flat along some axis spoils."""
+    program.at_most.append(({program.margin: -1.0}, -margin / 4))
+    roundness = program.roundness()
+    return program.solve({roundness: -1.0}, deadline - time.monotonic())
 
 
 def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
@@ -95,10 +118,10 @@ def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
         return None
     if not any(strict for _, strict in atoms):
         return None
-    for low in (1, 0):
+    for power, low in ((m, low) for m in MARGIN_POWERS for low in (1, 2, 0)):
         if time.monotonic() > deadline:
             return None
-        program = _RefutationProgram(len(states), atoms, low)
+        program = _RefutationProgram(len(states), atoms, low, power)
         if program.count > MAX_VARIABLES:
             return None
         x = program.solve({program.interior: -1.0}, deadline - time.monotonic())
@@ -131,9 +154,12 @@ def _domain_constraints(plan: Plan) -> list[P.Polynomial]:
 
 class _LyapunovProgram(Program):
     def __init__(self, n: int, field: list[P.Polynomial], constraints: list[P.Polynomial],
-                 degree: int):
+                 degree: int, power: int, discrete: bool):
         super().__init__(n)
+        self.discrete = discrete
+        self.change = lambda p: P.change(p, field, discrete)  # dV/dt or V(f(x)) - V(x)
         self.z = P.monomials(n, 1, degree)
+        self.states_block = self.z[:n]  # the linear monomials come first
         norm = _squared_norm(n)
         self.field = field
         # -dV/dt, part by part: the block is added with the Lie derivative of each entry
@@ -142,15 +168,15 @@ class _LyapunovProgram(Program):
         for j in range(len(self.z)):
             for i in range(j + 1):
                 basis = {P.times(self.z[i], self.z[j]): Fraction(1 if i == j else 2)}
-                self.add_term(self.count, P.scale(P.lie_derivative(basis, field), -1))
+                self.add_term(self.count, P.scale(self.change(basis), -1))
                 self.v_entries.append((self.count, i, j))
                 self.count += 1
         floor = P.scale(norm, V_FLOOR)
-        self.add_constant(P.scale(P.lie_derivative(floor, field), -1))
+        self.add_constant(P.scale(self.change(floor), -1))
         self.margin = self.scalar()
-        self.add_term(self.margin, P.scale(norm, -1))
-        top = max(2, max(P.degree(P.lie_derivative({P.times(a, b): Fraction(1)}, field))
-                         for a in self.z for b in self.z))
+        self.add_term(self.margin, P.scale(P.power(norm, power, n), -1))
+        top = max(2 * power, max(P.degree(self.change({P.times(a, b): Fraction(1)}))
+                                 for a in self.z for b in self.z))
         half = (top + 1) // 2
         self.gram(P.monomials(n, 1, half), P.constant(-1, n))
         for g in constraints:
@@ -158,6 +184,17 @@ class _LyapunovProgram(Program):
             if room >= 1:
                 self.gram(P.monomials(n, 1, room), P.scale(g, -1))
         self.equalities.append(({v: 1.0 for v, i, j in self.v_entries if i == j}, 1.0))
+
+    def roundness(self) -> int:
+        """mu with (P's block of linear monomials) - mu I >= 0, for an objective."""
+        mu = self.scalar()
+        linear = len(self.states_block)
+        shifted = self.gram(self.states_block, in_identity=False)
+        by_place = {(i, j): v for v, i, j in self.v_entries if j < linear}
+        for variable, i, j in shifted:
+            self.equalities.append(({by_place[i, j]: 1.0, variable: -1.0,
+                                     **({mu: -1.0} if i == j else {})}, 0.0))
+        return mu
 
     def exact_v(self, x) -> P.Polynomial:
         """z^T P z + e|x|^2 with P's entries rounded to DECIMALS decimals."""
@@ -173,22 +210,25 @@ class _RefutationProgram(Program):
     c_k >= 0 for strict h_k > 0 with sum c_k = 1; s0 = m^T (Q + tI) m with Q >= 0, and
     t (at most 1) as large as possible, so that s0's Gram matrix survives rounding."""
 
-    def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int):
+    def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int, power: int):
         super().__init__(n)
-        self.atoms = atoms
-        top = max(2, max(P.degree(h) for h, _ in atoms))
+        self.atoms = [(P.power(h, power, n) if strict else h, strict) for h, strict in atoms]
+        self.power = power
+        top = max(2, max(P.degree(h) for h, _ in self.atoms))
         half = (top + 1) // 2
         self.multipliers: list = []
-        for h, strict in atoms:
+        for h, strict in self.atoms:
             room = (2 * half - P.degree(h)) // 2
-            if strict or room < low:
+            if not strict and room >= low:
+                basis = P.monomials(n, low, room)
+                self.multipliers.append(("square", basis, self.gram(basis, h)))
+            elif strict or P.low_degree(h) >= 2 * low:  # s0 keeps no term below 2 low
                 c = self.scalar()
                 self.add_term(c, h)
                 self.at_most.append(({c: -1.0}, 0.0))  # c >= 0
                 self.multipliers.append(("constant", c))
             else:
-                basis = P.monomials(n, low, room)
-                self.multipliers.append(("square", basis, self.gram(basis, h)))
+                self.multipliers.append(("none",))
         strict = [m[1] for m, (_, s) in zip(self.multipliers, atoms) if s]
         self.equalities.append(({c: 1.0 for c in strict}, 1.0))
         self.basis = P.monomials(n, low, half)
@@ -200,10 +240,13 @@ class _RefutationProgram(Program):
     def exact(self, x) -> Refutation | None:
         multipliers = []
         total = {}
-        for (h, _), multiplier in zip(self.atoms, self.multipliers):
+        for (h, strict), multiplier in zip(self.atoms, self.multipliers):
+            if multiplier[0] == "none":
+                multipliers.append(None)
+                continue
             if multiplier[0] == "constant":
                 c = max(Fraction(0), _decimal(x[multiplier[1]], MULTIPLIER_DECIMALS))
-                multipliers.append(c)
+                multipliers.append(Power(c, self.power) if strict and self.power > 1 else c)
                 total = P.add(total, P.scale(h, c))
                 continue
             _, basis, entries = multiplier

@@ -136,3 +136,23 @@ def to_expr(p: Mapping[Monomial, Fraction], states: Sequence[str]) -> E.Expr:
                    for s, k in zip(states, monomial) if k]
         terms.append(E.mul(E.Num(coefficient), *factors))
     return E.add(*terms) if terms else E.ZERO
+
+
+def compose(p: Mapping[Monomial, Fraction], field: Sequence[Polynomial]) -> Polynomial:
+    """p(field(x)): the polynomial after one step of x+ = field(x)."""
+    n = len(field)
+    result: Polynomial = {}
+    for monomial, coefficient in p.items():
+        term = constant(coefficient, n)
+        for component, exponent in zip(field, monomial):
+            term = multiply(term, power(component, exponent, n))
+        result = add(result, term)
+    return result
+
+
+def change(p: Mapping[Monomial, Fraction], field: Sequence[Polynomial],
+           discrete: bool) -> Polynomial:
+    """dp/dt along x' = field(x), or p(field(x)) - p(x) for x+ = field(x)."""
+    if discrete:
+        return add(compose(p, field), scale(p, -1))
+    return lie_derivative(p, field)

@@ -3,14 +3,15 @@ rational arithmetic.
 
 The obligation's query must be a conjunction of polynomial comparisons; each is read as
 h_j(x) >= 0 or h_j(x) > 0 (h_j: one side minus the other). A refutation gives, in the
-query's order, a multiplier for each comparison: none, a rational constant c >= 0, or a
-sum of squares m(x)^T G m(x) (G rational and positive semidefinite); and a sum of
-squares s0. It refutes the query when
+query's order, a multiplier for each comparison: none, a rational constant c >= 0 (or
+c h^(m-1), making the term c h^m), or a sum of squares m(x)^T G m(x) (G rational and
+positive semidefinite); and a sum of squares s0. It refutes the query when
 
     s0(x) + sum_j sigma_j(x) h_j(x) = 0 for every x  (every coefficient cancels exactly)
 
-and some strict comparison h_k > 0 has a constant multiplier c_k > 0. At a point where
-the query held, every term would be >= 0 with sum 0, so every term 0; but c_k h_k > 0.
+and some strict comparison h_k > 0 has a constant multiplier c_k > 0 (or c_k h_k^(m-1)).
+At a point where the query held, every term would be >= 0 with sum 0, so every term 0;
+but c_k h_k^m > 0.
 So no point satisfies the query, and the obligation holds.
 """
 from __future__ import annotations
@@ -40,7 +41,16 @@ class SumOfSquares:
         return terms
 
 
-Multiplier = Fraction | SumOfSquares | None
+@dataclass(frozen=True)
+class Power:
+    """c h^(exponent - 1) as the multiplier of h: the term c h^exponent (for a strict
+    h > 0 and c > 0 that term is > 0, as a constant multiplier's is)."""
+
+    coefficient: Fraction
+    exponent: int
+
+
+Multiplier = Fraction | Power | SumOfSquares | None
 
 
 @dataclass(frozen=True)
@@ -96,10 +106,13 @@ def refutation_problem(refutation: Refutation, query: L.Formula,
         if isinstance(multiplier, SumOfSquares):
             total = P.add(total, P.multiply(multiplier.polynomial(), h))
             continue
-        if multiplier < 0:
-            return "a constant multiplier is negative"
-        total = P.add(total, P.scale(h, multiplier))
-        strict = strict or (is_strict and multiplier > 0)
+        if isinstance(multiplier, Fraction):
+            multiplier = Power(multiplier, 1)
+        if multiplier.coefficient < 0 or multiplier.exponent < 1:
+            return "a constant multiplier is negative, or a power is below 1"
+        term = P.power(h, multiplier.exponent, len(states))
+        total = P.add(total, P.scale(term, multiplier.coefficient))
+        strict = strict or (is_strict and multiplier.coefficient > 0)
     if not strict:
         return "no strict comparison has a positive constant multiplier"
     if total:
@@ -147,6 +160,8 @@ def refutation_from_json(data: dict) -> Refutation:
 def _multiplier_json(multiplier: Multiplier):
     if multiplier is None or isinstance(multiplier, SumOfSquares):
         return None if multiplier is None else _square_json(multiplier)
+    if isinstance(multiplier, Power):
+        return {"coefficient": str(multiplier.coefficient), "power": multiplier.exponent}
     return str(multiplier)
 
 
@@ -158,6 +173,8 @@ def _square_json(square: SumOfSquares) -> dict:
 def _multiplier(data) -> Multiplier:
     if data is None:
         return None
+    if isinstance(data, dict) and "power" in data:
+        return Power(Fraction(data["coefficient"]), int(data["power"]))
     return _square(data) if isinstance(data, dict) else Fraction(data)
 
 
