@@ -17,15 +17,17 @@ from fossil_dsl.ir import polynomials as P
 
 
 class Program:
-    """Gram blocks, scalars, one polynomial identity (every coefficient zero), linear
-    equalities and inequalities, a linear objective; solved by Clarabel."""
+    """Gram blocks, scalars, polynomial identities (every coefficient zero; terms go to
+    the current one, `new_identity` starts the next), linear equalities and
+    inequalities, a linear objective; solved by Clarabel."""
 
     def __init__(self, n: int):
         self.n = n
         self.count = 0  # variables
         self.blocks: list[tuple[int, list[P.Monomial]]] = []  # (first variable, basis)
-        self.identity: dict[P.Monomial, dict[int, float]] = {}
-        self.constant: dict[P.Monomial, float] = {}
+        self.tag = 0  # which identity terms are added to
+        self.identity: dict[tuple[int, P.Monomial], dict[int, float]] = {}
+        self.constant: dict[tuple[int, P.Monomial], float] = {}
         self.equalities: list[tuple[dict[int, float], float]] = []
         self.at_most: list[tuple[dict[int, float], float]] = []  # coefficients . x <= bound
 
@@ -50,14 +52,18 @@ class Program:
         self.count += 1
         return self.count - 1
 
+    def new_identity(self) -> None:
+        self.tag += 1
+
     def add_term(self, variable: int, polynomial: P.Polynomial) -> None:
         for monomial, coefficient in polynomial.items():
-            row = self.identity.setdefault(monomial, {})
+            row = self.identity.setdefault((self.tag, monomial), {})
             row[variable] = row.get(variable, 0.0) + float(coefficient)
 
     def add_constant(self, polynomial: P.Polynomial) -> None:
         for monomial, coefficient in polynomial.items():
-            self.constant[monomial] = self.constant.get(monomial, 0.0) + float(coefficient)
+            key = (self.tag, monomial)
+            self.constant[key] = self.constant.get(key, 0.0) + float(coefficient)
 
     def solve(self, objective: dict[int, float], seconds: float):
         import clarabel
@@ -68,8 +74,8 @@ class Program:
             for variable, coefficient in coefficients.items():
                 rows.append(len(right)), cols.append(variable), values.append(coefficient)
             right.append(value)
-        for monomial in sorted(set(self.identity) | set(self.constant)):
-            row(self.identity.get(monomial, {}), -self.constant.get(monomial, 0.0))
+        for key in sorted(set(self.identity) | set(self.constant)):
+            row(self.identity.get(key, {}), -self.constant.get(key, 0.0))
         for coefficients, value in self.equalities:
             row(coefficients, value)
         cones = [clarabel.ZeroConeT(len(right))]

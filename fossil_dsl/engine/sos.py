@@ -61,24 +61,38 @@ class SosFinding:
     change: str = "dV/dt"  # or V(f(x)) - V(x)
 
     def describe(self) -> str:
+        if self.change.startswith("B"):  # a barrier: its margin on I, U and the flow
+            return (f"sum-of-squares programming (Clarabel): B of degree {self.degree}, "
+                    f"{self.change} with margin {self.margin:.3g}, {self.seconds:.2f} s")
         return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}, "
                 f"{self.change} <= -{self.margin:.3g} |x|^{2 * self.power} on D, "
                 f"{self.seconds:.2f} s")
 
 
 def applies(plan: Plan) -> bool:
-    """A polynomial autonomous ODE, a Lyapunov-type property, and no template or
-    candidate chosen by the user."""
+    """A polynomial autonomous system, a Lyapunov-type property (or safety in continuous
+    time), and no template or candidate chosen by the user."""
     spec = plan.spec
-    return (plan.certificate.form in FORMS and plan.controller is None and not spec.inputs and spec.torch_dynamics is None
-            and spec.synthesis.certificate is None and spec.synthesis.candidate is None
-            and not plan.options.learn_only and _field(plan) is not None)
+    form = plan.certificate.form in FORMS or (
+        plan.certificate.form == "safety" and spec.time is TimeDomain.CONTINUOUS)
+    return (form and plan.controller is None and not spec.inputs
+            and spec.torch_dynamics is None and spec.synthesis.certificate is None
+            and spec.synthesis.candidate is None and not plan.options.learn_only
+            and field_of(plan) is not None)
+
+
+def find(plan: Plan, deadline: float) -> SosFinding | None:
+    """The certificate's function by sum of squares: V, or B for safety."""
+    if plan.certificate.form == "safety":
+        from fossil_dsl.engine.sos_barrier import barrier
+        return barrier(plan, deadline)
+    return lyapunov(plan, deadline)
 
 
 def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
     """The first V (by degree) whose program is feasible with a positive margin, or None."""
     started = time.monotonic()
-    field = _field(plan)
+    field = field_of(plan)
     constraints = _domain_constraints(plan)
     for degree, power in ((d, m) for d in DEGREES for m in MARGIN_POWERS):
         if time.monotonic() > deadline:
@@ -116,12 +130,13 @@ def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
         atoms = comparisons(query, states)
     except ValueError:
         return None
-    if not any(strict for _, strict in atoms):
-        return None
     for power, low in ((m, low) for m in MARGIN_POWERS for low in (1, 2, 0)):
         if time.monotonic() > deadline:
             return None
-        program = _RefutationProgram(len(states), atoms, low, power)
+        try:
+            program = _RefutationProgram(len(states), atoms, low, power)
+        except _Hopeless:
+            continue
         if program.count > MAX_VARIABLES:
             return None
         x = program.solve({program.interior: -1.0}, deadline - time.monotonic())
@@ -131,7 +146,7 @@ def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
     return None
 
 
-def _field(plan: Plan) -> list[P.Polynomial] | None:
+def field_of(plan: Plan) -> list[P.Polynomial] | None:
     try:
         return [P.polynomial(f, plan.states) for f in plan.spec.dynamics]
     except P.NotPolynomial:
@@ -139,14 +154,18 @@ def _field(plan: Plan) -> list[P.Polynomial] | None:
 
 
 def _domain_constraints(plan: Plan) -> list[P.Polynomial]:
-    """g with g >= 0 on D, from D's membership formula where it is a conjunction of
-    polynomial comparisons; others are left out (the program then asks for the decrease
-    on a larger set, which is stronger)."""
-    formula = plan.spec.domain.contains_formula(plan.states)
+    return set_constraints(plan.spec.domain, plan.states)
+
+
+def set_constraints(region, states) -> list[P.Polynomial]:
+    """g with g >= 0 on the set, from its membership formula where that is a conjunction
+    of polynomial comparisons; others are left out (a program then asks for its
+    condition on a larger set, which is stronger)."""
+    formula = region.contains_formula(states)
     found = []
     for atom in (formula.args if isinstance(formula, L.And) else (formula,)):
         try:
-            found += [h for h, _ in comparisons(atom, plan.states)]
+            found += [h for h, _ in comparisons(atom, states)]
         except ValueError:
             continue
     return found
@@ -230,6 +249,14 @@ class _RefutationProgram(Program):
             else:
                 self.multipliers.append(("none",))
         strict = [m[1] for m, (_, s) in zip(self.multipliers, atoms) if s]
+        self.constant_term = None
+        if low == 0:  # the comparison 1 > 0 (s0 and the multipliers have constant terms)
+            self.constant_term = self.scalar()
+            self.add_term(self.constant_term, P.constant(1, n))
+            self.at_most.append(({self.constant_term: -1.0}, 0.0))
+            strict.append(self.constant_term)
+        if not strict:
+            raise _Hopeless()
         self.equalities.append(({c: 1.0 for c in strict}, 1.0))
         self.basis = P.monomials(n, low, half)
         self.rest = self.gram(self.basis)
@@ -255,11 +282,19 @@ class _RefutationProgram(Program):
                 return None
             multipliers.append(square)
             total = P.add(total, P.multiply(square.polynomial(), h))
+        constant = Fraction(0)
+        if self.constant_term is not None:
+            constant = max(Fraction(0), _decimal(x[self.constant_term], MULTIPLIER_DECIMALS))
+            total = P.add(total, P.constant(constant, self.n))
         G = self.matrix(x, self.rest, len(self.basis)) + x[self.interior] * np.eye(len(self.basis))
         rest = _projected(self.basis, G, P.scale(total, -1))
         if rest is None:
             return None
-        return Refutation(tuple(multipliers), rest)
+        return Refutation(tuple(multipliers), rest, constant)
+
+
+class _Hopeless(Exception):
+    """No strict comparison to refute with (and no constant in this basis)."""
 
 
 def _squared_norm(n: int) -> P.Polynomial:

@@ -9,9 +9,10 @@ positive semidefinite); and a sum of squares s0. It refutes the query when
 
     s0(x) + sum_j sigma_j(x) h_j(x) = 0 for every x  (every coefficient cancels exactly)
 
-and some strict comparison h_k > 0 has a constant multiplier c_k > 0 (or c_k h_k^(m-1)).
-At a point where the query held, every term would be >= 0 with sum 0, so every term 0;
-but c_k h_k^m > 0.
+and some strict comparison h_k > 0 has a constant multiplier c_k > 0 (or c_k h_k^(m-1)),
+or a constant c > 0 is added to the sum (the strict comparison 1 > 0). At a point where
+the query held, every term would be >= 0 with sum 0, so every term 0; but c_k h_k^m > 0
+(or c > 0).
 So no point satisfies the query, and the obligation holds.
 """
 from __future__ import annotations
@@ -57,6 +58,7 @@ Multiplier = Fraction | Power | SumOfSquares | None
 class Refutation:
     multipliers: tuple[Multiplier, ...]  # one per comparison of the query, in order
     rest: SumOfSquares  # s0
+    constant: Fraction = Fraction(0)  # c >= 0 added to the sum (the comparison 1 > 0)
 
 
 def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynomial, bool]]:
@@ -98,8 +100,10 @@ def refutation_problem(refutation: Refutation, query: L.Formula,
                                    if isinstance(m, SumOfSquares)]
     if not all(positive_semidefinite(s.gram) for s in squares):
         return "a Gram matrix is not positive semidefinite"
-    total = refutation.rest.polynomial()
-    strict = False
+    if refutation.constant < 0:
+        return "the constant is negative"
+    total = P.add(refutation.rest.polynomial(), P.constant(refutation.constant, len(states)))
+    strict = refutation.constant > 0
     for (h, is_strict), multiplier in zip(atoms, refutation.multipliers):
         if multiplier is None:
             continue
@@ -114,7 +118,7 @@ def refutation_problem(refutation: Refutation, query: L.Formula,
         total = P.add(total, P.scale(term, multiplier.coefficient))
         strict = strict or (is_strict and multiplier.coefficient > 0)
     if not strict:
-        return "no strict comparison has a positive constant multiplier"
+        return "no strict comparison has a positive constant multiplier, and no constant"
     if total:
         return f"the identity fails: {len(total)} coefficients do not cancel"
     return None
@@ -148,13 +152,13 @@ def positive_semidefinite(gram: Sequence[Sequence[Fraction]]) -> bool:
 def refutation_json(refutation: Refutation, states: Sequence[str]) -> dict:
     return {"states": list(states),
             "multipliers": [_multiplier_json(m) for m in refutation.multipliers],
-            "rest": _square_json(refutation.rest)}
+            "rest": _square_json(refutation.rest), "constant": str(refutation.constant)}
 
 
 def refutation_from_json(data: dict) -> Refutation:
     """Raises ValueError (or KeyError, TypeError) where the data is malformed."""
     return Refutation(tuple(_multiplier(m) for m in data["multipliers"]),
-                      _square(data["rest"]))
+                      _square(data["rest"]), Fraction(data.get("constant", "0")))
 
 
 def _multiplier_json(multiplier: Multiplier):
