@@ -6,10 +6,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fossil_dsl.engine import sos
+from fossil_dsl.solvers import sos_refutation
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
-from fossil_dsl.kernel.positivstellensatz import (Refutation, SumOfSquares, positive_semidefinite,
+from fossil_dsl.solvers.positivstellensatz import (Refutation, SumOfSquares, positive_semidefinite,
                                                   refutation_from_json, refutation_json,
                                                   refutation_problem)
 
@@ -50,7 +50,7 @@ def test_a_satisfiable_query_has_no_refutation_and_a_borrowed_one_fails():
     satisfiable = L.conjunction(L.Compare("<=", NORM, E.Num(F(1))), L.Compare(">", NORM, E.ZERO),
                                 L.Compare(">=", X, E.ZERO))
     import time
-    assert sos.refute(satisfiable, STATES, time.monotonic() + 10) is None
+    assert sos_refutation.refute(satisfiable, STATES, time.monotonic() + 10) is None
     assert refutation_problem(HAND_MADE, satisfiable, STATES) is not None
 
 
@@ -61,7 +61,7 @@ def test_the_engine_finds_a_refutation_the_kernel_accepts_and_its_file_form_roun
     query = L.conjunction(L.Compare("<=", NORM, E.Num(F(1))), L.Compare(">", NORM, E.ZERO),
                           L.negation(L.Compare("<", change, E.ZERO)))
     import time
-    found = sos.refute(query, STATES, time.monotonic() + 30)
+    found = sos_refutation.refute(query, STATES, time.monotonic() + 30)
     assert found is not None and refutation_problem(found, query, STATES) is None
     again = refutation_from_json(refutation_json(found, STATES))
     assert again == found
@@ -95,7 +95,7 @@ def test_semidefinite_with_a_zero_pivot_and_asymmetric_matrices():
 
 def test_a_power_of_a_strict_comparison_refutes_and_round_trips():
     """|x|^2 > 0 and -(|x|^2)^2 >= 0: the term 1 * (|x|^2)^2 cancels the second."""
-    from fossil_dsl.kernel.positivstellensatz import Power
+    from fossil_dsl.solvers.positivstellensatz import Power
     query = L.conjunction(L.Compare(">", NORM, E.ZERO),
                           L.Compare(">=", E.neg(E.power(NORM, E.Num(F(2)))), E.ZERO))
     good = Refutation((Power(F(1), 2), F(1)), ZERO_SQUARE)

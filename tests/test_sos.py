@@ -123,9 +123,20 @@ def test_six_states_are_proved_by_refutations_that_export_recheck_and_load(tmp_p
     data = json.loads(exported.read_text())
     data["rest"]["gram"][0][0] = str(-1)  # no longer positive semidefinite
     exported.write_text(json.dumps(data))
-    again = fossil_dsl.load_result(tmp_path, timeout=2)
+    from fossil_dsl.kernel.prove import GIVEN_REFUTATION
+    from fossil_dsl.outputs.recheck import read_refutations
+    tampered = read_refutations(tmp_path)["condition:decrease"]
+    obligation = next(p.obligation for p in result.kernel.proofs
+                      if p.obligation.name == "condition:decrease")
+    from fossil_dsl.solvers.positivstellensatz import refutation_problem
+    assert "not positive semidefinite" in refutation_problem(tampered, obligation.query,
+                                                             result.plan.states)
+    again = fossil_dsl.load_result(tmp_path, timeout=5)
     decrease = [p for p in again.kernel.proofs if p.obligation.name == "condition:decrease"]
-    assert not decrease or decrease[0].procedure != "sum of squares (exact)"
+    # the tampered evidence is not what proves it (the kernel may find its own)
+    assert not decrease or decrease[0].detail != GIVEN_REFUTATION
+    assert procedures and [p.detail for p in result.kernel.proofs
+                           if p.obligation.name == "condition:decrease"] == [GIVEN_REFUTATION]
 
 
 MARGINAL = """\
@@ -202,3 +213,26 @@ def test_a_six_state_safety_property_gets_a_quadratic_barrier_by_sum_of_squares(
     assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 2")
     procedures = {p.obligation.name: p.procedure for p in result.kernel.proofs}
     assert procedures["condition:flow"] == "sum of squares (exact)"
+
+
+def _ring(n: int) -> str:
+    xs = [f"x{i}" for i in range(1, n + 1)]
+    zero = ", ".join(["0"] * n)
+    lines = [f"state {', '.join(xs)}", "dynamics continuous {"]
+    lines += [f"    {xs[i]}' = -{xs[i]} + 0.5*{xs[(i + 1) % n]}" for i in range(n)]
+    lines += ["}", f"domain ball([{zero}], 4)", f"set init = ball([{zero}], 0.5)",
+              f"set unsafe = ~ball([{zero}], 3)", "prove from init: always not unsafe"]
+    return "\n".join(lines) + "\n"
+
+
+def test_eight_states_check_and_certify_with_refutations_for_relations_too():
+    """Z3 does not decide within the checker's 5 s that two balls in 8 dimensions are
+    disjoint; a sum-of-squares refutation does (and the kernel's relations, and the
+    barrier's conditions, and B > 0 on the boundary of D for the stronger guarantee)."""
+    checked = fossil_dsl.check_text(_ring(8), "ring8.fsl")
+    assert checked.ok, checked.render()
+    result = fossil_dsl.synthesise(checked.spec, timeout=120)
+    assert result.certified, result.summary()
+    by_text = {p.obligation.text: p.procedure for p in result.kernel.proofs}
+    assert by_text["I and U are disjoint"] == "sum of squares (exact)"
+    assert result.kernel.strengthened is not None  # never leaves D: B > 0 on its boundary

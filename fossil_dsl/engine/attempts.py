@@ -8,11 +8,13 @@ import time
 from dataclasses import replace
 
 from fossil_dsl.engine import sos
+from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, IterationRecord, Verdict, as_listener
 from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.api import Backend, Status
+from fossil_dsl.solvers.sos_refutation import refute
 
 SOS_SHARE = 0.25  # of the run's time, at most, for the sum-of-squares attempt
 SOS_SECONDS = 30.0  # and never more than this
@@ -39,7 +41,8 @@ def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
     """((plan with V given, certified outcome) or None, what happened)."""
     listener.phase(0, "sum-of-squares program")
     budget = min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
-    finding = sos.find(plan, time.monotonic() + budget)
+    search = barrier if plan.certificate.form == "safety" else sos.lyapunov
+    finding = search(plan, time.monotonic() + budget)
     if finding is None:
         return None, "no sum-of-squares certificate found"
     given = replace(plan, functions=tuple(replace(f, candidate=finding.formula)
@@ -68,7 +71,7 @@ def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
                   plan.origin_radius)
     refutations = {}
     for obligation in list_obligations(claim):
-        found = sos.refute(obligation.query, plan.states, deadline)
+        found = refute(obligation.query, plan.states, deadline)
         if found is not None:
             refutations[obligation.name] = found
     verdicts = tuple(Verdict(c.name, Status.UNSAT, solver=SUM_OF_SQUARES)

@@ -1,5 +1,5 @@
 """Sum-of-squares programming for polynomial systems: a convex first attempt at a Lyapunov
-function, and exact refutations that the kernel checks without a solver.
+function (and, in sos_barrier.py, a barrier).
 
 Lyapunov function. For x' = f(x) with f polynomial, find V(x) = z^T P z + e|x|^2 (z:
 the monomials of degree 1..d, P >= 0, trace P = 1) and the largest t with
@@ -11,43 +11,32 @@ t > 0, V > 0 and dV/dt < 0 on D away from the origin. For a map x+ = f(x), V(f(x
 takes the place of dV/dt. V is rounded to rationals: a candidate, proved (or not) like
 any other.
 
-Refutation. For a kernel obligation whose query is a conjunction of polynomial
-comparisons h_j >= 0 (or > 0), find multipliers with s0 + sum_j sigma_j h_j = 0
-(kernel/positivstellensatz.py states why that proves the query unsatisfiable), round
-them to rationals, and absorb the rounding error into s0's Gram matrix exactly (an
-orthogonal projection onto the matrices that satisfy the identity). The kernel checks
-the identity and positive semidefiniteness in rational arithmetic.
-
-The programs are built and solved in sdp.py.
+Refutations of the kernel's obligations for the V found are searched for by
+solvers/sos_refutation.py. The programs are built and solved in sdp.py.
 """
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 from fractions import Fraction
 
-import numpy as np
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.kernel.positivstellensatz import (Power, Refutation, SumOfSquares, comparisons,
-                                                  positive_semidefinite)
-from fossil_dsl.engine.sdp import Program
+from fossil_dsl.solvers.positivstellensatz import comparisons
+from fossil_dsl.solvers.sdp import Program
+from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
 from fossil_dsl.plan.compile import Plan
 
 FORMS = ("stability", "region of attraction")  # whose conditions a Lyapunov V meets on D
 DEGREES = (1, 2)  # V of degree 2, then 4 (z of degree up to d)
-MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
 V_FLOOR = Fraction(1, 1000)  # e in V = z^T P z + e|x|^2: V >= e|x|^2
 DECIMALS = 6  # kept of P's entries (trace P = 1: entries are at most 1)
-MULTIPLIER_DECIMALS = 12  # kept of a refutation's multipliers
 MIN_MARGIN = 1e-7  # t below this is numerical noise, not a decrease
 # the decrease asked for: t|x|^2, else t|x|^4 (where the linearisation is only marginally
-# stable, as for x' = -x^3 + y, y' = -x - y^3); a refutation likewise uses c h or c h^2
-# for a strict comparison h > 0
+# stable, as for x' = -x^3 + y, y' = -x - y^3)
 MARGIN_POWERS = (1, 2)
 
 
@@ -79,14 +68,6 @@ def applies(plan: Plan) -> bool:
             and spec.torch_dynamics is None and spec.synthesis.certificate is None
             and spec.synthesis.candidate is None and not plan.options.learn_only
             and field_of(plan) is not None)
-
-
-def find(plan: Plan, deadline: float) -> SosFinding | None:
-    """The certificate's function by sum of squares: V, or B for safety."""
-    if plan.certificate.form == "safety":
-        from fossil_dsl.engine.sos_barrier import barrier
-        return barrier(plan, deadline)
-    return lyapunov(plan, deadline)
 
 
 def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
@@ -122,28 +103,6 @@ def _roundest(program: "_LyapunovProgram", margin: float, deadline: float):
     program.at_most.append(({program.margin: -1.0}, -margin / 4))
     roundness = program.roundness()
     return program.solve({roundness: -1.0}, deadline - time.monotonic())
-
-
-def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
-    """A refutation of the query (see the module's text), or None."""
-    try:
-        atoms = comparisons(query, states)
-    except ValueError:
-        return None
-    for power, low in ((m, low) for m in MARGIN_POWERS for low in (1, 2, 0)):
-        if time.monotonic() > deadline:
-            return None
-        try:
-            program = _RefutationProgram(len(states), atoms, low, power)
-        except _Hopeless:
-            continue
-        if program.count > MAX_VARIABLES:
-            return None
-        x = program.solve({program.interior: -1.0}, deadline - time.monotonic())
-        found = program.exact(x) if x is not None else None
-        if found is not None:
-            return found
-    return None
 
 
 def field_of(plan: Plan) -> list[P.Polynomial] | None:
@@ -219,125 +178,12 @@ class _LyapunovProgram(Program):
         """z^T P z + e|x|^2 with P's entries rounded to DECIMALS decimals."""
         terms = [P.scale(_squared_norm(self.n), V_FLOOR)]
         for variable, i, j in self.v_entries:
-            weight = _decimal(x[variable], DECIMALS) * (1 if i == j else 2)
+            weight = decimal(x[variable], DECIMALS) * (1 if i == j else 2)
             terms.append({P.times(self.z[i], self.z[j]): weight})
         return P.add(*terms)
-
-
-class _RefutationProgram(Program):
-    """s0 + sum_j sigma_j h_j = 0: sigma_j SOS for non-strict h_j >= 0, constants
-    c_k >= 0 for strict h_k > 0 with sum c_k = 1; s0 = m^T (Q + tI) m with Q >= 0, and
-    t (at most 1) as large as possible, so that s0's Gram matrix survives rounding."""
-
-    def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int, power: int):
-        super().__init__(n)
-        self.atoms = [(P.power(h, power, n) if strict else h, strict) for h, strict in atoms]
-        self.power = power
-        top = max(2, max(P.degree(h) for h, _ in self.atoms))
-        half = (top + 1) // 2
-        self.multipliers: list = []
-        for h, strict in self.atoms:
-            room = (2 * half - P.degree(h)) // 2
-            if not strict and room >= low:
-                basis = P.monomials(n, low, room)
-                self.multipliers.append(("square", basis, self.gram(basis, h)))
-            elif strict or P.low_degree(h) >= 2 * low:  # s0 keeps no term below 2 low
-                c = self.scalar()
-                self.add_term(c, h)
-                self.at_most.append(({c: -1.0}, 0.0))  # c >= 0
-                self.multipliers.append(("constant", c))
-            else:
-                self.multipliers.append(("none",))
-        strict = [m[1] for m, (_, s) in zip(self.multipliers, atoms) if s]
-        self.constant_term = None
-        if low == 0:  # the comparison 1 > 0 (s0 and the multipliers have constant terms)
-            self.constant_term = self.scalar()
-            self.add_term(self.constant_term, P.constant(1, n))
-            self.at_most.append(({self.constant_term: -1.0}, 0.0))
-            strict.append(self.constant_term)
-        if not strict:
-            raise _Hopeless()
-        self.equalities.append(({c: 1.0 for c in strict}, 1.0))
-        self.basis = P.monomials(n, low, half)
-        self.rest = self.gram(self.basis)
-        self.interior = self.scalar()
-        self.add_term(self.interior, {P.times(m, m): Fraction(1) for m in self.basis})
-        self.at_most.append(({self.interior: 1.0}, 1.0))
-
-    def exact(self, x) -> Refutation | None:
-        multipliers = []
-        total = {}
-        for (h, strict), multiplier in zip(self.atoms, self.multipliers):
-            if multiplier[0] == "none":
-                multipliers.append(None)
-                continue
-            if multiplier[0] == "constant":
-                c = max(Fraction(0), _decimal(x[multiplier[1]], MULTIPLIER_DECIMALS))
-                multipliers.append(Power(c, self.power) if strict and self.power > 1 else c)
-                total = P.add(total, P.scale(h, c))
-                continue
-            _, basis, entries = multiplier
-            square = _psd_square(basis, self.matrix(x, entries, len(basis)))
-            if square is None:
-                return None
-            multipliers.append(square)
-            total = P.add(total, P.multiply(square.polynomial(), h))
-        constant = Fraction(0)
-        if self.constant_term is not None:
-            constant = max(Fraction(0), _decimal(x[self.constant_term], MULTIPLIER_DECIMALS))
-            total = P.add(total, P.constant(constant, self.n))
-        G = self.matrix(x, self.rest, len(self.basis)) + x[self.interior] * np.eye(len(self.basis))
-        rest = _projected(self.basis, G, P.scale(total, -1))
-        if rest is None:
-            return None
-        return Refutation(tuple(multipliers), rest, constant)
-
-
-class _Hopeless(Exception):
-    """No strict comparison to refute with (and no constant in this basis)."""
 
 
 def _squared_norm(n: int) -> P.Polynomial:
     return {tuple(int(k == i) * 2 for k in range(n)): Fraction(1) for i in range(n)}
 
 
-def _decimal(value: float, decimals: int) -> Fraction:
-    return Fraction(round(float(value) * 10 ** decimals), 10 ** decimals) \
-        if math.isfinite(value) else Fraction(0)
-
-
-def _psd_square(basis, G: np.ndarray) -> SumOfSquares | None:
-    """G rounded to rationals; nudged up the diagonal if rounding left it indefinite."""
-    for nudge in (0.0, 1e-10, 1e-8):
-        gram = _rational_matrix(G + nudge * np.eye(len(basis)))
-        if positive_semidefinite(gram):
-            return SumOfSquares(tuple(basis), gram)
-    return None
-
-
-def _rational_matrix(G: np.ndarray) -> tuple[tuple[Fraction, ...], ...]:
-    size = len(G)
-    rows = [[_decimal((G[i, j] + G[j, i]) / 2, MULTIPLIER_DECIMALS) for j in range(size)]
-            for i in range(size)]
-    return tuple(tuple(row) for row in rows)
-
-
-def _projected(basis, G: np.ndarray, target: P.Polynomial) -> SumOfSquares | None:
-    """The rational Gram matrix nearest to G (Frobenius) with m^T G m = target exactly,
-    if it is positive semidefinite: each entry (a, b) feeds one monomial m_a m_b, so the
-    projection spreads each monomial's residual evenly over its entries."""
-    gram = [list(row) for row in _rational_matrix(G)]
-    classes: dict[P.Monomial, list[tuple[int, int]]] = {}
-    for a, ma in enumerate(basis):
-        for b, mb in enumerate(basis):
-            classes.setdefault(P.times(ma, mb), []).append((a, b))
-    if any(monomial not in classes for monomial in target):
-        return None
-    for monomial, pairs in classes.items():
-        residual = target.get(monomial, Fraction(0)) - sum(gram[a][b] for a, b in pairs)
-        if residual:
-            share = residual / len(pairs)
-            for a, b in pairs:
-                gram[a][b] += share
-    rational = tuple(tuple(row) for row in gram)
-    return SumOfSquares(tuple(basis), rational) if positive_semidefinite(rational) else None

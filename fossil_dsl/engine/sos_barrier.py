@@ -17,9 +17,9 @@ from __future__ import annotations
 import time
 from fractions import Fraction
 
-from fossil_dsl.engine.sdp import Program
-from fossil_dsl.engine.sos import (MAX_VARIABLES, MIN_MARGIN, SosFinding, _decimal, field_of,
-                                   set_constraints)
+from fossil_dsl.solvers.sdp import Program
+from fossil_dsl.engine.sos import MIN_MARGIN, SosFinding, field_of, set_constraints
+from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.plan.compile import Plan
@@ -29,7 +29,7 @@ from fossil_dsl.plan.compile import Plan
 # learning does (37 s against 6 s)
 DEGREES = (1,)
 DECAY_RATES = (1.0, 0.1, 10.0)  # mu, in the order tried
-DECIMALS = 8  # kept of B's coefficients (each is at most 1)
+DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 
 
 def barrier(plan: Plan, deadline: float) -> SosFinding | None:
@@ -90,4 +90,4 @@ class _BarrierProgram(Program):
         self.new_identity()
 
     def exact_b(self, x) -> P.Polynomial:
-        return P.add(*({m: _decimal(x[v], DECIMALS)} for m, v in zip(self.basis, self.coefficients)))
+        return P.add(*({m: decimal(x[v], DECIMALS)} for m, v in zip(self.basis, self.coefficients)))

@@ -4,7 +4,9 @@
 - A query with a sum-of-squares refutation (positivstellensatz.py) that checks exactly
   (a polynomial identity and positive semidefinite Gram matrices, in rationals) is proved.
 - Arithmetic queries (polynomials, division, integer powers, abs) go to Z3 on exact
-  rationals, then to the interval procedure, then to CVC5, each with a share of the time
+  rationals, then to a sum-of-squares refutation (found by a semidefinite program, then
+  checked exactly; first from 6 states on), then to the interval procedure, then to
+  CVC5, each with a share of the time
   (a hard nonlinear query can stall Z3 and CVC5 for minutes where the interval
   procedure refutes it in seconds; a `first` procedure, the one that proved the
   condition during the run, goes first: only the order changes). Irrational constants
@@ -28,7 +30,7 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel.obligations import Obligation
-from fossil_dsl.kernel.positivstellensatz import refutation_problem
+from fossil_dsl.solvers.positivstellensatz import refutation_problem
 from fossil_dsl.solvers.api import Answer, Status
 
 
@@ -56,11 +58,12 @@ def is_arithmetic(formula: L.Formula) -> bool:
                for side in (c.left, c.right))
 
 
-# Shares of an arithmetic obligation's time: Z3, the interval procedure, CVC5.
-SHARES = {"z3": 0.3, "interval": 0.5, "cvc5": 0.2}
-
-
 SUM_OF_SQUARES = "sum of squares (exact)"
+GIVEN_REFUTATION = "the refutation handed over with the claim"  # (not one found here)
+# Shares of an arithmetic obligation's time: Z3, a sum-of-squares refutation (checked
+# exactly; for conjunctions of polynomial comparisons), the interval procedure, CVC5.
+SHARES = {"z3": 0.3, SUM_OF_SQUARES: 0.1, "interval": 0.4, "cvc5": 0.2}
+SOS_FIRST = 6
 
 
 def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
@@ -71,14 +74,17 @@ def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
         outcome = Outcome.FAILS if exact else Outcome.PROVED
         return Proof(obligation, outcome, "exact arithmetic")
     if refutation is not None and refutation_problem(refutation, query, states) is None:
-        return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES)
+        return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES, GIVEN_REFUTATION)
     if is_arithmetic(query):
         return _arithmetic(obligation, states, timeout, delta, first)
     return _interval(obligation, states, timeout, delta)
 
 
 def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str) -> Proof:
-    order = sorted(SHARES, key=lambda name: name != first)
+    # from SOS_FIRST states on, Z3 (exponential in the variables) goes after the
+    # sum-of-squares refutation (a semidefinite program, polynomial in them)
+    order = sorted(SHARES, key=lambda name: (name != first, not (
+        name == SUM_OF_SQUARES and len(states) >= SOS_FIRST)))
     reasons = []
     for name in order:
         budget = max(1.0, SHARES[name] * timeout)
@@ -100,8 +106,9 @@ def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: st
 
 def _solver(name: str):
     from fossil_dsl.solvers.cvc5_backend import Cvc5Backend
+    from fossil_dsl.solvers.sos_refutation import SosBackend
     from fossil_dsl.solvers.z3_backend import Z3Backend
-    return {"z3": Z3Backend, "cvc5": Cvc5Backend}[name]()
+    return {"z3": Z3Backend, "cvc5": Cvc5Backend, SUM_OF_SQUARES: SosBackend}[name]()
 
 
 def _interval(obligation: Obligation, states, timeout: float, delta) -> Proof:

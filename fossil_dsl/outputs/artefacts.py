@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 from fossil_dsl.kernel.obligations import file_stem
-from fossil_dsl.kernel.positivstellensatz import refutation_json
+from fossil_dsl.solvers.positivstellensatz import refutation_json
 from fossil_dsl.outputs import onnx_export
 from fossil_dsl.outputs.summary import summary_text
 

@@ -24,7 +24,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel import Claim, NoRule, list_obligations
 from fossil_dsl.kernel.export import script
 from fossil_dsl.kernel.obligations import file_stem
-from fossil_dsl.kernel.positivstellensatz import refutation_from_json, refutation_problem
+from fossil_dsl.solvers.positivstellensatz import refutation_from_json, refutation_problem
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.api import Status

@@ -1,0 +1,178 @@
+"""Sum-of-squares refutations: a decision procedure that only ever proves.
+
+For a query that is a conjunction of polynomial comparisons h_j >= 0 (or > 0), find
+multipliers with s0 + sum_j sigma_j h_j (+ c) = 0 (positivstellensatz.py states why
+that proves the query unsatisfiable) by a semidefinite program (sdp.py), round them to
+rationals, and absorb the rounding error into s0's Gram matrix exactly (an orthogonal
+projection onto the Gram matrices that satisfy the identity: each entry feeds one
+monomial, so each monomial's residual is spread evenly over its entries). The result is
+checked exactly before it is returned: a refutation from here is a proof. `SosBackend`
+answers UNSAT with it, and UNKNOWN otherwise (never SAT: it finds no counterexamples).
+"""
+from __future__ import annotations
+
+import math
+import time
+from fractions import Fraction
+from typing import Sequence
+
+import numpy as np
+
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.solvers.api import Answer, Status
+from fossil_dsl.solvers.positivstellensatz import (Power, Refutation, SumOfSquares, comparisons,
+                                                  positive_semidefinite, refutation_problem)
+from fossil_dsl.solvers.sdp import Program
+
+MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
+MULTIPLIER_DECIMALS = 12  # kept of a refutation's multipliers
+POWERS = (1, 2)  # a strict comparison h > 0 enters as c h, else c h^2 (quartic decreases)
+
+
+class SosBackend:
+    name = "sum of squares (exact)"
+
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop=None) -> Answer:
+        found = refute(formula, variables, time.monotonic() + timeout)
+        if found is None:
+            return Answer(Status.UNKNOWN, reason="no sum-of-squares refutation found")
+        return Answer(Status.UNSAT, solver=self.name)
+
+
+def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
+    """A refutation of the query that checks exactly (see the module's text), or None."""
+    try:
+        atoms = comparisons(query, states)
+    except ValueError:
+        return None
+    for power, low in ((m, low) for m in POWERS for low in (1, 2, 0)):
+        if time.monotonic() > deadline:
+            return None
+        try:
+            program = _RefutationProgram(len(states), atoms, low, power)
+        except _Hopeless:
+            continue
+        if program.count > MAX_VARIABLES:
+            return None
+        x = program.solve({program.interior: -1.0}, deadline - time.monotonic())
+        found = program.exact(x) if x is not None else None
+        if found is not None and refutation_problem(found, query, states) is None:
+            return found
+    return None
+
+
+class _RefutationProgram(Program):
+    """s0 + sum_j sigma_j h_j = 0: sigma_j SOS for non-strict h_j >= 0, constants
+    c_k >= 0 for strict h_k > 0 with sum c_k = 1; s0 = m^T (Q + tI) m with Q >= 0, and
+    t (at most 1) as large as possible, so that s0's Gram matrix survives rounding."""
+
+    def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int, power: int):
+        super().__init__(n)
+        self.atoms = [(P.power(h, power, n) if strict else h, strict) for h, strict in atoms]
+        self.power = power
+        top = max(2, max(P.degree(h) for h, _ in self.atoms))
+        half = (top + 1) // 2
+        self.multipliers: list = []
+        for h, strict in self.atoms:
+            room = (2 * half - P.degree(h)) // 2
+            if not strict and room >= low:
+                basis = P.monomials(n, low, room)
+                self.multipliers.append(("square", basis, self.gram(basis, h)))
+            elif strict or P.low_degree(h) >= 2 * low:  # s0 keeps no term below 2 low
+                c = self.scalar()
+                self.add_term(c, h)
+                self.at_most.append(({c: -1.0}, 0.0))  # c >= 0
+                self.multipliers.append(("constant", c))
+            else:
+                self.multipliers.append(("none",))
+        strict = [m[1] for m, (_, s) in zip(self.multipliers, atoms) if s]
+        self.constant_term = None
+        if low == 0:  # the comparison 1 > 0 (s0 and the multipliers have constant terms)
+            self.constant_term = self.scalar()
+            self.add_term(self.constant_term, P.constant(1, n))
+            self.at_most.append(({self.constant_term: -1.0}, 0.0))
+            strict.append(self.constant_term)
+        if not strict:
+            raise _Hopeless()
+        self.equalities.append(({c: 1.0 for c in strict}, 1.0))
+        self.basis = P.monomials(n, low, half)
+        self.rest = self.gram(self.basis)
+        self.interior = self.scalar()
+        self.add_term(self.interior, {P.times(m, m): Fraction(1) for m in self.basis})
+        self.at_most.append(({self.interior: 1.0}, 1.0))
+
+    def exact(self, x) -> Refutation | None:
+        multipliers = []
+        total = {}
+        for (h, strict), multiplier in zip(self.atoms, self.multipliers):
+            if multiplier[0] == "none":
+                multipliers.append(None)
+                continue
+            if multiplier[0] == "constant":
+                c = max(Fraction(0), decimal(x[multiplier[1]], MULTIPLIER_DECIMALS))
+                multipliers.append(Power(c, self.power) if strict and self.power > 1 else c)
+                total = P.add(total, P.scale(h, c))
+                continue
+            _, basis, entries = multiplier
+            square = _psd_square(basis, self.matrix(x, entries, len(basis)))
+            if square is None:
+                return None
+            multipliers.append(square)
+            total = P.add(total, P.multiply(square.polynomial(), h))
+        constant = Fraction(0)
+        if self.constant_term is not None:
+            constant = max(Fraction(0), decimal(x[self.constant_term], MULTIPLIER_DECIMALS))
+            total = P.add(total, P.constant(constant, self.n))
+        G = self.matrix(x, self.rest, len(self.basis)) + x[self.interior] * np.eye(len(self.basis))
+        rest = _projected(self.basis, G, P.scale(total, -1))
+        if rest is None:
+            return None
+        return Refutation(tuple(multipliers), rest, constant)
+
+
+class _Hopeless(Exception):
+    """No strict comparison to refute with (and no constant in this basis)."""
+
+
+def decimal(value: float, decimals: int) -> Fraction:
+    return Fraction(round(float(value) * 10 ** decimals), 10 ** decimals) \
+        if math.isfinite(value) else Fraction(0)
+
+
+def _psd_square(basis, G: np.ndarray) -> SumOfSquares | None:
+    """G rounded to rationals; nudged up the diagonal if rounding left it indefinite."""
+    for nudge in (0.0, 1e-10, 1e-8):
+        gram = _rational_matrix(G + nudge * np.eye(len(basis)))
+        if positive_semidefinite(gram):
+            return SumOfSquares(tuple(basis), gram)
+    return None
+
+
+def _rational_matrix(G: np.ndarray) -> tuple[tuple[Fraction, ...], ...]:
+    size = len(G)
+    rows = [[decimal((G[i, j] + G[j, i]) / 2, MULTIPLIER_DECIMALS) for j in range(size)]
+            for i in range(size)]
+    return tuple(tuple(row) for row in rows)
+
+
+def _projected(basis, G: np.ndarray, target: P.Polynomial) -> SumOfSquares | None:
+    """The rational Gram matrix nearest to G (Frobenius) with m^T G m = target exactly,
+    if it is positive semidefinite: each entry (a, b) feeds one monomial m_a m_b, so the
+    projection spreads each monomial's residual evenly over its entries."""
+    gram = [list(row) for row in _rational_matrix(G)]
+    classes: dict[P.Monomial, list[tuple[int, int]]] = {}
+    for a, ma in enumerate(basis):
+        for b, mb in enumerate(basis):
+            classes.setdefault(P.times(ma, mb), []).append((a, b))
+    if any(monomial not in classes for monomial in target):
+        return None
+    for monomial, pairs in classes.items():
+        residual = target.get(monomial, Fraction(0)) - sum(gram[a][b] for a, b in pairs)
+        if residual:
+            share = residual / len(pairs)
+            for a, b in pairs:
+                gram[a][b] += share
+    rational = tuple(tuple(row) for row in gram)
+    return SumOfSquares(tuple(basis), rational) if positive_semidefinite(rational) else None
