@@ -236,3 +236,14 @@ def test_eight_states_check_and_certify_with_refutations_for_relations_too():
     by_text = {p.obligation.text: p.procedure for p in result.kernel.proofs}
     assert by_text["I and U are disjoint"] == "sum of squares (exact)"
     assert result.kernel.strengthened is not None  # never leaves D: B > 0 on its boundary
+
+
+def test_refutations_the_kernel_found_itself_are_exported_and_rechecked(tmp_path):
+    from fossil_dsl.outputs.recheck import recheck
+    result = fossil_dsl.synthesise(fossil_dsl.check_text(_ring(8), "ring8.fsl").spec,
+                                   timeout=120)
+    assert result.certified
+    result.save(tmp_path)
+    assert (tmp_path / "obligations" / "relation-initial_and_unsafe.sos.json").exists()
+    checks = recheck(tmp_path, timeout=10)
+    assert all(c.reproved for c in checks), [(c.condition, c.reason) for c in checks]

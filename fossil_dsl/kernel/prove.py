@@ -47,6 +47,7 @@ class Proof:
     procedure: str
     detail: str = ""
     witness: tuple[Fraction, ...] | None = None
+    evidence: object = None  # the sum-of-squares refutation that proved it, if one did
 
     @property
     def proved(self) -> bool:
@@ -74,7 +75,8 @@ def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
         outcome = Outcome.FAILS if exact else Outcome.PROVED
         return Proof(obligation, outcome, "exact arithmetic")
     if refutation is not None and refutation_problem(refutation, query, states) is None:
-        return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES, GIVEN_REFUTATION)
+        return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES, GIVEN_REFUTATION,
+                     evidence=refutation)
     if is_arithmetic(query):
         return _arithmetic(obligation, states, timeout, delta, first)
     return _interval(obligation, states, timeout, delta)
@@ -96,7 +98,7 @@ def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: st
             continue
         answer = _solver(name).check(obligation.query, states, budget)
         if answer.status is Status.UNSAT:
-            return Proof(obligation, Outcome.PROVED, name)
+            return Proof(obligation, Outcome.PROVED, name, evidence=answer.evidence)
         if answer.status is Status.SAT and not answer.approximate:
             return Proof(obligation, Outcome.FAILS, name, "counterexample",
                          _point(answer, states))

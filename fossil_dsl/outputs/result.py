@@ -244,7 +244,13 @@ def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
                   obligations(plan, outcome, verdict.strengthened), len(outcome.history), outcome.learn_seconds,
                   outcome.verify_seconds, total_seconds, candidate.digits,
                   dict(outcome.networks), verdict, outcome.interrupted, outcome.strategy,
-                  dict(outcome.refutations))
+                  {**outcome.refutations, **_found_by_kernel(verdict)})
+
+
+def _found_by_kernel(verdict: Verdict) -> dict:
+    """The refutations that proved obligations (handed over, or found by the kernel), to
+    be exported with them."""
+    return {p.obligation.name: p.evidence for p in verdict.proofs if p.evidence is not None}
 
 
 def obligations(plan: Plan, outcome: CegisOutcome,

@@ -27,6 +27,7 @@ class Answer:
     # irrational coordinates that are reported as nearby rationals
     approximate: bool = False
     solver: str = ""  # which solver answered, where a backend combines several
+    evidence: object = None  # what proves an UNSAT where the backend has it (a refutation)
 
 
 class UnsupportedTheory(FslError):

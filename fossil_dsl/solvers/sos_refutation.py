@@ -38,7 +38,7 @@ class SosBackend:
         found = refute(formula, variables, time.monotonic() + timeout)
         if found is None:
             return Answer(Status.UNKNOWN, reason="no sum-of-squares refutation found")
-        return Answer(Status.UNSAT, solver=self.name)
+        return Answer(Status.UNSAT, solver=self.name, evidence=found)
 
 
 def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
