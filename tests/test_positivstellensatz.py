@@ -104,3 +104,11 @@ def test_a_power_of_a_strict_comparison_refutes_and_round_trips():
     assert "power is below 1" in refutation_problem(Refutation((Power(F(1), 0), F(1)), ZERO_SQUARE),
                                                      query, STATES)
     assert refutation_problem(Refutation((F(1), F(1)), ZERO_SQUARE), query, STATES) is not None
+
+
+def test_only_the_four_inequalities_are_read():
+    """A comparison of another kind (were one ever built) is not read as an inequality:
+    the query is then not refutable here at all."""
+    odd = L.conjunction(L.Compare(">", NORM, E.ZERO), L.Compare("==", NORM, E.ZERO))
+    assert "not a conjunction of polynomial comparisons" in refutation_problem(
+        Refutation((F(1), F(1)), ZERO_SQUARE), odd, STATES)

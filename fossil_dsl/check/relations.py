@@ -24,10 +24,10 @@ from fossil_dsl.ir.expr import to_text
 from fossil_dsl.ir.numbers import number_text
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.api import Answer, Backend, Status
+from fossil_dsl.solvers.positivstellensatz import BEFORE_Z3_FROM
 
 RELATION_TIMEOUT = 2.5  # seconds per query
 RELATION_BUDGET = 5.0  # seconds for all of a spec's queries: checking is never slow
-SOS_FIRST = 6  # states from which a sum-of-squares refutation is tried before Z3
 
 
 def point_text(values: Sequence[Fraction]) -> str:
@@ -64,13 +64,12 @@ class RelationProver:
     def _decide(self, formula: L.Formula) -> Answer:
         """The backend's answer; where it has none, a sum-of-squares refutation's, then
         the interval procedure's (each loaded only then: most relations are decided at
-        once). From SOS_FIRST states on, the refutation goes first: Z3's procedure grows
-        exponentially with the variables (two balls in 8 dimensions: no answer in 5 s)."""
-        if len(self.states) >= SOS_FIRST and self._refuted(formula):
+        once); with many states the refutation goes first (BEFORE_Z3_FROM)."""
+        early = len(self.states) >= BEFORE_Z3_FROM
+        if early and self._refuted(formula):
             return Answer(Status.UNSAT, solver="a sum-of-squares refutation")
         answer = self._ask(self.backend, formula)
-        if answer.status is Status.UNKNOWN and len(self.states) < SOS_FIRST \
-                and self._refuted(formula):
+        if answer.status is Status.UNKNOWN and not early and self._refuted(formula):
             return Answer(Status.UNSAT, solver="a sum-of-squares refutation")
         if answer.status is Status.UNKNOWN and registry.is_installed("interval"):
             second = self._ask(registry.load("interval"), formula)

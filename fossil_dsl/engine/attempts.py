@@ -74,10 +74,8 @@ def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
         found = refute(obligation.query, plan.states, deadline)
         if found is not None:
             refutations[obligation.name] = found
-    verdicts = tuple(Verdict(c.name, Status.UNSAT, solver=SUM_OF_SQUARES)
-                     if f"condition:{c.name}" in refutations
-                     else Verdict(c.name, Status.UNKNOWN, "no refutation found")
-                     for c in plan.conditions)
+    verdicts = _settled(tuple(Verdict(c.name, Status.UNKNOWN, "no refutation found")
+                              for c in plan.conditions), refutations)
     certified = all(v.status is Status.UNSAT for v in verdicts)
     seconds = time.monotonic() - started
     return CegisOutcome(certified, "every condition proved" if certified else
@@ -91,10 +89,16 @@ def _merged(outcome: CegisOutcome, refutations: dict) -> CegisOutcome:
     refutation where there is one. (A "counterexample" of a delta-decision verifier near
     the origin is no obstacle: a refutation that checks shows there is none; where there
     is a true one, no refutation exists.)"""
-    verdicts = tuple(replace(v, status=Status.UNSAT, solver=SUM_OF_SQUARES, reason="",
-                             counterexample=None)
-                     if v.status is not Status.UNSAT and f"condition:{v.condition}" in refutations
-                     else v for v in outcome.verdicts)
+    verdicts = _settled(outcome.verdicts, refutations)
     certified = not outcome.interrupted and all(v.status is Status.UNSAT for v in verdicts)
     return replace(outcome, certified=certified, verdicts=verdicts, refutations=refutations,
                    reason="every condition proved" if certified else outcome.reason)
+
+
+def _settled(verdicts, refutations: dict) -> tuple[Verdict, ...]:
+    """Each condition not proved yet that a refutation of the kernel's obligation for it
+    settles, as proved by it."""
+    return tuple(replace(v, status=Status.UNSAT, solver=SUM_OF_SQUARES, reason="",
+                         counterexample=None)
+                 if v.status is not Status.UNSAT and f"condition:{v.condition}" in refutations
+                 else v for v in verdicts)

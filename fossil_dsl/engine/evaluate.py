@@ -16,8 +16,11 @@ from fossil_dsl.ir import logic as L
 _NUMPY_NAMES = {"atan": "arctan"}  # where numpy's name differs from the language's
 
 
-def library(value):
-    """torch or numpy, whichever `value` (an array, or a mapping of them) belongs to."""
+def _library(value, env: Mapping):
+    """torch or numpy: the library of `value`, or, where it is a plain number, of the
+    batch in `env`."""
+    if isinstance(value, float):
+        value = next(iter(env.values()), value)
     torch = sys.modules.get("torch")  # loaded only by runs that learn
     return torch if torch is not None and isinstance(value, torch.Tensor) else np
 
@@ -48,7 +51,7 @@ def evaluate(expr: E.Expr, env: Mapping):
 
 
 def _apply(func: str, value, env: Mapping):
-    xp = library(value if not isinstance(value, float) else next(iter(env.values()), value))
+    xp = _library(value, env)
     if xp is np:
         return getattr(np, _NUMPY_NAMES.get(func, func))(np.asarray(value, dtype=np.float64))
     value = value if isinstance(value, xp.Tensor) else xp.tensor(value, dtype=xp.float64)
@@ -76,7 +79,7 @@ def holds(formula: L.Formula, env: Mapping, batch: int, slack: float = 0.0):
 
 def _full(value, env: Mapping, batch: int):
     """`value` (a number or an array of the batch) as an array of the batch."""
-    xp = library(value if not isinstance(value, float) else next(iter(env.values()), value))
+    xp = _library(value, env)
     if xp is np:
         return np.broadcast_to(np.asarray(value, dtype=np.float64), (batch,))
     return xp.as_tensor(value, dtype=xp.float64).expand(batch)

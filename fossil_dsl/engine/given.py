@@ -18,12 +18,12 @@ def verifier_only(plan: Plan) -> bool:
 class GivenFunctions:
     """Stands in for the learner of the loop when there is nothing to learn."""
 
-    networks: dict = {}
     controller = None
     trainable = False
 
     def __init__(self, plan: Plan):
         self.plan = plan
+        self.networks: dict = {}
         self.digits = plan.options.digits
         self.candidates = {f.name: f.candidate for f in plan.functions}
         self.samples = initial_samples(plan, np.random.default_rng(plan.options.seed))

@@ -53,19 +53,17 @@ def around(points, region: SetExpr, states: Sequence[str], count: int, radius: f
     neighbours = points.repeat_interleave(count, 0) + noise
     box = region.bounding_box() or box
     if box is not None:
-        neighbours = _reflect_into(neighbours, box)
+        neighbours = _reflect_into(neighbours, box, generator)
     keep = holds(region.contains_formula(states), state_env(states, neighbours),
                  len(neighbours))
     return _concatenate([points, neighbours[keep]], generator)
 
 
-def _reflect_into(points, box):
-    import torch  # learning only
-    low = torch.tensor(box[0], dtype=torch.float64)
-    high = torch.tensor(box[1], dtype=torch.float64)
-    points = torch.where(points < low, 2 * low - points, points)
-    points = torch.where(points > high, 2 * high - points, points)
-    return torch.minimum(torch.maximum(points, low), high)
+def _reflect_into(points, box, generator):
+    low, high = _array(box[0], generator), _array(box[1], generator)
+    points = _where(points < low, 2 * low - points, points)
+    points = _where(points > high, 2 * high - points, points)
+    return _where(points < low, low, _where(points > high, high, points))  # clamped
 
 
 def _boundary(inner: SetExpr, states, count: int, generator, fallback_box):

@@ -22,10 +22,9 @@ from fractions import Fraction
 
 
 from fossil_dsl.ir import expr as E
-from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.solvers.positivstellensatz import comparisons
+from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
 from fossil_dsl.plan.compile import Plan
@@ -42,20 +41,16 @@ MARGIN_POWERS = (1, 2)
 
 @dataclass(frozen=True)
 class SosFinding:
-    formula: E.Expr  # V, exact (rounded)
-    degree: int  # of V
-    margin: float  # t of the program
-    power: int  # dV/dt <= -t |x|^(2 power)
+    formula: E.Expr  # exact (rounded)
+    function: str  # "V" or "B"
+    degree: int
+    margin: float  # of the program
+    condition: str  # what the program asked for, with its margin, in words
     seconds: float
-    change: str = "dV/dt"  # or V(f(x)) - V(x)
 
     def describe(self) -> str:
-        if self.change.startswith("B"):  # a barrier: its margin on I, U and the flow
-            return (f"sum-of-squares programming (Clarabel): B of degree {self.degree}, "
-                    f"{self.change} with margin {self.margin:.3g}, {self.seconds:.2f} s")
-        return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}, "
-                f"{self.change} <= -{self.margin:.3g} |x|^{2 * self.power} on D, "
-                f"{self.seconds:.2f} s")
+        return (f"sum-of-squares programming (Clarabel): {self.function} of degree "
+                f"{self.degree}, {self.condition}, {self.seconds:.2f} s")
 
 
 def applies(plan: Plan) -> bool:
@@ -74,7 +69,7 @@ def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
     """The first V (by degree) whose program is feasible with a positive margin, or None."""
     started = time.monotonic()
     field = field_of(plan)
-    constraints = _domain_constraints(plan)
+    constraints = set_constraints(plan.spec.domain, plan.states)
     for degree, power in ((d, m) for d in DEGREES for m in MARGIN_POWERS):
         if time.monotonic() > deadline:
             return None
@@ -85,14 +80,15 @@ def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is None or x[program.margin] <= MIN_MARGIN:
             continue
-        margin = float(x[program.margin])
         if plan.certificate.form == "region of attraction":
-            rounder = _roundest(program, margin, deadline)
+            rounder = _roundest(program, float(x[program.margin]), deadline)
             x = rounder if rounder is not None else x
         formula = P.to_expr(program.exact_v(x), plan.states)
-        return SosFinding(formula, 2 * degree, float(x[program.margin]), power,
-                          time.monotonic() - started,
-                          "V(f(x)) - V(x)" if program.discrete else "dV/dt")
+        margin = float(x[program.margin])
+        change = "V(f(x)) - V(x)" if program.discrete else "dV/dt"
+        return SosFinding(formula, "V", 2 * degree, margin,
+                          f"{change} <= -{margin:.3g} |x|^{2 * power} on D",
+                          time.monotonic() - started)
     return None
 
 
@@ -112,17 +108,12 @@ def field_of(plan: Plan) -> list[P.Polynomial] | None:
         return None
 
 
-def _domain_constraints(plan: Plan) -> list[P.Polynomial]:
-    return set_constraints(plan.spec.domain, plan.states)
-
-
 def set_constraints(region, states) -> list[P.Polynomial]:
     """g with g >= 0 on the set, from its membership formula where that is a conjunction
     of polynomial comparisons; others are left out (a program then asks for its
     condition on a larger set, which is stronger)."""
-    formula = region.contains_formula(states)
     found = []
-    for atom in (formula.args if isinstance(formula, L.And) else (formula,)):
+    for atom in conjuncts(region.contains_formula(states)):
         try:
             found += [h for h, _ in comparisons(atom, states)]
         except ValueError:
@@ -135,39 +126,24 @@ class _LyapunovProgram(Program):
                  degree: int, power: int, discrete: bool):
         super().__init__(n)
         self.discrete = discrete
-        self.change = lambda p: P.change(p, field, discrete)  # dV/dt or V(f(x)) - V(x)
+        change = lambda p: P.change(p, field, discrete)  # dV/dt or V(f(x)) - V(x)
         self.z = P.monomials(n, 1, degree)
         self.states_block = self.z[:n]  # the linear monomials come first
         norm = _squared_norm(n)
-        self.field = field
-        # -dV/dt, part by part: the block is added with the Lie derivative of each entry
-        self.v_entries = []
-        self.blocks.append((self.count, self.z))
-        for j in range(len(self.z)):
-            for i in range(j + 1):
-                basis = {P.times(self.z[i], self.z[j]): Fraction(1 if i == j else 2)}
-                self.add_term(self.count, P.scale(self.change(basis), -1))
-                self.v_entries.append((self.count, i, j))
-                self.count += 1
-        floor = P.scale(norm, V_FLOOR)
-        self.add_constant(P.scale(self.change(floor), -1))
+        self.v_entries = self.gram(self.z, lambda p: P.scale(change(p), -1))  # -dV, part by part
+        self.add_constant(P.scale(change(P.scale(norm, V_FLOOR)), -1))
         self.margin = self.scalar()
         self.add_term(self.margin, P.scale(P.power(norm, power, n), -1))
-        top = max(2 * power, max(P.degree(self.change({P.times(a, b): Fraction(1)}))
+        top = max(2 * power, max(P.degree(change({P.times(a, b): Fraction(1)}))
                                  for a in self.z for b in self.z))
-        half = (top + 1) // 2
-        self.gram(P.monomials(n, 1, half), P.constant(-1, n))
-        for g in constraints:
-            room = (2 * half - P.degree(g)) // 2
-            if room >= 1:
-                self.gram(P.monomials(n, 1, room), P.scale(g, -1))
+        self.minus_certificate((top + 1) // 2, constraints, low=1)
         self.equalities.append(({v: 1.0 for v, i, j in self.v_entries if i == j}, 1.0))
 
     def roundness(self) -> int:
         """mu with (P's block of linear monomials) - mu I >= 0, for an objective."""
         mu = self.scalar()
         linear = len(self.states_block)
-        shifted = self.gram(self.states_block, in_identity=False)
+        shifted = self.gram(self.states_block, lambda p: {})
         by_place = {(i, j): v for v, i, j in self.v_entries if j < linear}
         for variable, i, j in shifted:
             self.equalities.append(({by_place[i, j]: 1.0, variable: -1.0,

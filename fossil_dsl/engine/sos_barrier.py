@@ -9,7 +9,8 @@ Find a polynomial B (coefficients in [-1, 1]) and the largest e with
 with every s and every multiplier a sum of squares, for a fixed mu > 0 from a short list
 (the third condition is the exponential barrier condition dB/dt <= -mu B - e; with mu
 fixed the program stays convex). If e > 0, B is rounded to rationals and handed on as a
-candidate: the refutations of the kernel's obligations (sos.refute) or the solvers prove
+candidate: refutations of the kernel's obligations (solvers/sos_refutation.py) or the
+solvers prove
 it, or not.
 """
 from __future__ import annotations
@@ -51,9 +52,10 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
             if x is None or x[program.margin] <= MIN_MARGIN:
                 continue
             formula = P.to_expr(program.exact_b(x), states)
-            return SosFinding(formula, 2 * degree, float(x[program.margin]), 1,
-                              time.monotonic() - started,
-                              f"B < 0 on I, B > 0 on U, dB/dt <= -{mu:g} B on D")
+            margin = float(x[program.margin])
+            return SosFinding(formula, "B", 2 * degree, margin,
+                              f"B < 0 on I, B > 0 on U, dB/dt <= -{mu:g} B on D with "
+                              f"margin {margin:.3g}", time.monotonic() - started)
     return None
 
 
@@ -76,17 +78,11 @@ class _BarrierProgram(Program):
 
     def _condition(self, terms, constraints) -> None:
         """sum of terms - e = s + sum_i sigma_i g_i, as one identity."""
-        n = self.n
         for variable, polynomial in terms:
             self.add_term(variable, polynomial)
-        self.add_term(self.margin, P.constant(-1, n))
+        self.add_term(self.margin, P.constant(-1, self.n))
         top = max([2] + [P.degree(p) for _, p in terms] + [P.degree(g) for g in constraints])
-        half = (top + 1) // 2
-        self.gram(P.monomials(n, 0, half), P.constant(-1, n))
-        for g in constraints:
-            room = (2 * half - P.degree(g)) // 2
-            if room >= 0:
-                self.gram(P.monomials(n, 0, room), P.scale(g, -1))
+        self.minus_certificate((top + 1) // 2, constraints, low=0)
         self.new_identity()
 
     def exact_b(self, x) -> P.Polynomial:

@@ -30,7 +30,7 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel.obligations import Obligation
-from fossil_dsl.solvers.positivstellensatz import refutation_problem
+from fossil_dsl.solvers.positivstellensatz import BEFORE_Z3_FROM, refutation_problem
 from fossil_dsl.solvers.api import Answer, Status
 
 
@@ -64,7 +64,6 @@ GIVEN_REFUTATION = "the refutation handed over with the claim"  # (not one found
 # Shares of an arithmetic obligation's time: Z3, a sum-of-squares refutation (checked
 # exactly; for conjunctions of polynomial comparisons), the interval procedure, CVC5.
 SHARES = {"z3": 0.3, SUM_OF_SQUARES: 0.1, "interval": 0.4, "cvc5": 0.2}
-SOS_FIRST = 6
 
 
 def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
@@ -83,10 +82,9 @@ def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
 
 
 def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str) -> Proof:
-    # from SOS_FIRST states on, Z3 (exponential in the variables) goes after the
-    # sum-of-squares refutation (a semidefinite program, polynomial in them)
-    order = sorted(SHARES, key=lambda name: (name != first, not (
-        name == SUM_OF_SQUARES and len(states) >= SOS_FIRST)))
+    early = len(states) >= BEFORE_Z3_FROM  # the refutation before Z3
+    order = sorted(SHARES, key=lambda name: (name != first,
+                                             not (early and name == SUM_OF_SQUARES)))
     reasons = []
     for name in order:
         budget = max(1.0, SHARES[name] * timeout)

@@ -65,12 +65,13 @@ def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynom
     """(h, strict) for each comparison h >= 0 / h > 0 of a conjunctive query; raises
     ValueError where the query is not a conjunction of polynomial comparisons."""
     found = []
-    for atom in _conjuncts(query):
-        if isinstance(atom, L.Not) and isinstance(atom.arg, L.Compare):
+    for atom in conjuncts(query):
+        if isinstance(atom, L.Not) and isinstance(atom.arg, L.Compare) \
+                and atom.arg.relation in NEGATED:
             inner = atom.arg
             atom = L.Compare(NEGATED[inner.relation], inner.left, inner.right)
-        if not isinstance(atom, L.Compare):
-            raise ValueError(f"not a comparison: {atom}")
+        if not isinstance(atom, L.Compare) or atom.relation not in NEGATED:
+            raise ValueError(f"not an inequality: {atom}")
         larger, smaller = (atom.left, atom.right) if atom.relation in (">", ">=") \
             else (atom.right, atom.left)
         found.append((P.polynomial(add(larger, neg(smaller)), states),
@@ -79,11 +80,15 @@ def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynom
 
 
 NEGATED = {"<": ">=", "<=": ">", ">": "<=", ">=": "<"}
+# states from which a refutation is looked for before Z3 is asked: Z3's procedure grows
+# exponentially with the variables (two balls in 8 dimensions: no answer in 5 s), the
+# semidefinite program polynomially
+BEFORE_Z3_FROM = 6
 
 
-def _conjuncts(query: L.Formula) -> list[L.Formula]:
+def conjuncts(query: L.Formula) -> list[L.Formula]:
     if isinstance(query, L.And):
-        return [atom for arg in query.args for atom in _conjuncts(arg)]
+        return [atom for arg in query.args for atom in conjuncts(arg)]
     return [query]
 
 

@@ -1,7 +1,7 @@
 """Semidefinite programs over polynomial identities, solved by Clarabel: Gram blocks
-(positive semidefinite matrices G, each standing for m(x)^T G m(x) times a polynomial),
-scalars, one identity whose every coefficient must vanish, linear equalities and
-inequalities, and a linear objective.
+(positive semidefinite matrices G, each standing for m(x)^T G m(x), or what an identity
+makes of it), scalars, identities whose every coefficient must vanish, linear equalities
+and inequalities, and a linear objective.
 
 Clarabel is used directly rather than through a modelling layer: cvxpy and the solvers
 it requires (SCS, OSQP, HiGHS) add 230 MB to the install, Clarabel alone 3 MB.
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
+from typing import Callable
 
 import numpy as np
 
@@ -31,22 +32,30 @@ class Program:
         self.equalities: list[tuple[dict[int, float], float]] = []
         self.at_most: list[tuple[dict[int, float], float]] = []  # coefficients . x <= bound
 
-    def gram(self, basis: list[P.Monomial], times: P.Polynomial | None = None,
-             in_identity: bool = True):
-        """A PSD block G over the basis, adding (m^T G m) * times to the identity (unless
-        not `in_identity`); returns [(variable, i, j)] for its upper triangle, column by
-        column."""
-        times = times or P.constant(1, self.n)
+    def gram(self, basis: list[P.Monomial], of: Callable[[P.Polynomial], P.Polynomial] = None):
+        """A PSD block G over the basis, adding of(m^T G m) to the identity (`of` is linear:
+        m^T G m itself by default, a product with a polynomial, a derivative, nothing);
+        returns [(variable, i, j)] for its upper triangle, column by column."""
         self.blocks.append((self.count, basis))
         entries = []
         for j in range(len(basis)):
             for i in range(j + 1):
-                if in_identity:
-                    product = {P.times(basis[i], basis[j]): Fraction(1 if i == j else 2)}
-                    self.add_term(self.count, P.multiply(product, times))
+                product = {P.times(basis[i], basis[j]): Fraction(1 if i == j else 2)}
+                self.add_term(self.count, of(product) if of else product)
                 entries.append((self.count, i, j))
                 self.count += 1
         return entries
+
+    def minus_certificate(self, half: int, constraints: list[P.Polynomial], low: int) -> None:
+        """Subtracts s + sum_i sigma_i g_i from the identity (so that what it holds is
+        >= 0 wherever every g_i >= 0): s over the monomials of degree low..half, sigma_i
+        over low..room, where room keeps sigma_i g_i within degree 2 half."""
+        self.gram(P.monomials(self.n, low, half), lambda p: P.scale(p, -1))
+        for g in constraints:
+            room = (2 * half - P.degree(g)) // 2
+            if room >= low:
+                self.gram(P.monomials(self.n, low, room),
+                          lambda p, g=g: P.scale(P.multiply(p, g), -1))
 
     def scalar(self) -> int:
         self.count += 1

@@ -79,7 +79,8 @@ class _RefutationProgram(Program):
             room = (2 * half - P.degree(h)) // 2
             if not strict and room >= low:
                 basis = P.monomials(n, low, room)
-                self.multipliers.append(("square", basis, self.gram(basis, h)))
+                self.multipliers.append(("square", basis,
+                                         self.gram(basis, lambda p, h=h: P.multiply(p, h))))
             elif strict or P.low_degree(h) >= 2 * low:  # s0 keeps no term below 2 low
                 c = self.scalar()
                 self.add_term(c, h)
