@@ -16,7 +16,20 @@ from fossil_dsl.engine.loop import IterationRecord, Verdict
 from fossil_dsl.solvers.api import Status
 
 ROOT = Path(__file__).resolve().parent.parent
-LONG_RUN = ROOT / "specs" / "literature" / "lit16_oscillator_rswa.fsl"  # 25 iterations, ~80 s
+# A false property (the orbit through init runs through unsafe): never certified, so the
+# run goes on learning, iteration after iteration, until it is stopped.
+LONG_RUN = """
+state x0, x1
+dynamics continuous {
+    x0' = x1
+    x1' = -x0
+}
+domain box([-2, -2], [2, 2])
+set init = ball([1, 0], 0.1)
+set unsafe = ball([0, -1], 0.1)
+prove from init: always not unsafe
+synthesis { max_iters: 1000 }
+"""
 
 
 def _start(*arguments: str) -> subprocess.Popen:
@@ -26,7 +39,9 @@ def _start(*arguments: str) -> subprocess.Popen:
 
 
 def test_ctrl_c_stops_with_a_partial_summary_and_exit_130(tmp_path):
-    run = _start(str(LONG_RUN), "-o", str(tmp_path / "out"), "--verbose")
+    spec = tmp_path / "false_safety.fsl"
+    spec.write_text(LONG_RUN)
+    run = _start(str(spec), "-o", str(tmp_path / "out"), "--verbose")
     first = ""
     while "iteration   2" not in first:  # two iterations done: a candidate was verified
         line = run.stderr.readline()
@@ -38,7 +53,7 @@ def test_ctrl_c_stops_with_a_partial_summary_and_exit_130(tmp_path):
     assert run.returncode == 130, out + err
     assert time.monotonic() - stopped < 30
     assert "NOT CERTIFIED" in out and "why: interrupted (Ctrl-C) in iteration" in out
-    assert "V(x) = " in out and "guarantee: nothing is proved" in out
+    assert "B(x) = " in out and "guarantee: nothing is proved" in out
     assert "Traceback" not in err
     data = json.loads((tmp_path / "out" / "result.json").read_text())
     assert data["interrupted"] is True and data["verdict"] == "not certified"

@@ -12,7 +12,7 @@ import time
 
 import torch
 
-from fossil_dsl.engine import linear
+from fossil_dsl.engine import linear, reach_seed
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
 from fossil_dsl.engine.levels import initial_samples, level_value
 from fossil_dsl.engine.loss import GUARD_BAND, condition_loss, guard_mask, placeholders
@@ -68,7 +68,8 @@ class Learner(ViolationSearch):
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V or B (and LQR controller) as the starting point
-        self.seeded = linear.seed(plan, self.networks, self.controller, self.samples)
+        self.seeded = linear.seed(plan, self.networks, self.controller, self.samples) \
+            or reach_seed.seed(plan, self.networks, self.controller, self.samples)
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
 

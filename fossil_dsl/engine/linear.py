@@ -88,6 +88,19 @@ def local_certificate(spec: CheckedSpec, controlled: bool, inputs=None):
     """(P, K): P positive definite with a negative definite change along the linearised
     closed loop u = inputs - K x (K None without inputs); None where the linearisation is
     not stable (not stabilisable) or P is too ill-conditioned to round."""
+    found = closed_loop(spec, controlled, inputs)
+    if found is None:
+        return None
+    A, K = found
+    P = lyapunov_matrix(A, spec.time is TimeDomain.DISCRETE)
+    return None if P is None else (P, K)
+
+
+def closed_loop(spec: CheckedSpec, controlled: bool, inputs=None, state_weight=None,
+                input_weight=None):
+    """(A - B K, K): the linearisation at the origin closed by the LQR gain for the
+    weights (identities by default; K None without control), or None where it is not
+    stable (not stabilisable) or has no finite Jacobian."""
     from scipy import linalg
     found = jacobians(spec, inputs)
     if found is None:
@@ -97,27 +110,39 @@ def local_certificate(spec: CheckedSpec, controlled: bool, inputs=None):
     K = None
     try:
         if controlled and B.size:
-            identity_u = np.eye(B.shape[1])
+            Q = np.eye(len(A)) if state_weight is None else state_weight
+            R = np.eye(B.shape[1]) if input_weight is None else input_weight
             if discrete:
-                S = linalg.solve_discrete_are(A, B, np.eye(len(A)), identity_u)
-                K = np.linalg.solve(identity_u + B.T @ S @ B, B.T @ S @ A)
+                S = linalg.solve_discrete_are(A, B, Q, R)
+                K = np.linalg.solve(R + B.T @ S @ B, B.T @ S @ A)
             else:
-                S = linalg.solve_continuous_are(A, B, np.eye(len(A)), identity_u)
-                K = B.T @ S
+                S = linalg.solve_continuous_are(A, B, Q, R)
+                K = np.linalg.solve(R, B.T @ S)
             A = A - B @ K
-        stable = (np.abs(np.linalg.eigvals(A)) < 1).all() if discrete \
-            else (np.linalg.eigvals(A).real < 0).all()
-        if not stable:
-            return None
-        P = linalg.solve_discrete_lyapunov(A.T, np.eye(len(A))) if discrete \
-            else linalg.solve_continuous_lyapunov(A.T, -np.eye(len(A)))
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    stable = (np.abs(np.linalg.eigvals(A)) < 1).all() if discrete \
+        else (np.linalg.eigvals(A).real < 0).all()
+    return (A, K) if stable else None
+
+
+def lyapunov_matrix(A: np.ndarray, discrete: bool, decrease=None) -> np.ndarray | None:
+    """P (largest eigenvalue 1) with A^T P + P A = -Q (P - A^T P A = Q in discrete time)
+    for a stable A and Q = `decrease` (default I); None where P is too ill-conditioned
+    to round."""
+    from scipy import linalg
+    Q = np.eye(len(A)) if decrease is None else decrease
+    try:
+        P = linalg.solve_discrete_lyapunov(A.T, Q) if discrete \
+            else linalg.solve_continuous_lyapunov(A.T, -Q)
     except (np.linalg.LinAlgError, ValueError):
         return None
     P = (P + P.T) / 2
     eigenvalues = np.linalg.eigvalsh(P)
-    if eigenvalues[0] <= 0 or eigenvalues[-1] / eigenvalues[0] > MAX_CONDITION:
+    if not np.all(np.isfinite(P)) or eigenvalues[0] <= 0 \
+            or eigenvalues[-1] / eigenvalues[0] > MAX_CONDITION:
         return None
-    return P / eigenvalues[-1], K
+    return P / eigenvalues[-1]
 
 
 def seed(plan, networks: dict[str, Network], controller: Network | None,

@@ -176,17 +176,21 @@ def substitute(formula: Formula, mapping) -> Formula:
 
 
 def boundary_outer(formula: Formula) -> Formula:
-    """A closed set containing the boundary of the set that `formula` describes.
+    """A closed set containing the boundary of the set A that `formula` describes.
 
-    Where no comparison is at equality, every comparison keeps its truth value nearby (for
-    continuous expressions), so the point is not on the boundary; and the boundary lies
-    in the closure. Exact for boxes, balls and ellipsoids.
+    Three closed sets contain the boundary, and so does their intersection: the closure
+    of A and the closure of its complement (∂A is their intersection; for continuous
+    expressions `closed_outer` gives a closed superset of each), and the points where
+    some comparison is at equality (elsewhere every comparison keeps its truth value
+    nearby, so the point is not on the boundary). Exact for boxes, balls and ellipsoids,
+    and for a domain minus such a set: the second set is what keeps the lines through a
+    box's faces, outside the box, off the boundary of D \\ U.
     """
     atoms = {(c.left, c.right): c for c in comparisons(formula)}
     on_some_atom = disjunction(*(conjunction(Compare("<=", left, right),
                                              Compare(">=", left, right))
                                  for left, right in atoms))
-    return conjunction(closed_outer(formula), on_some_atom)
+    return conjunction(closed_outer(formula), closed_outer(negation(formula)), on_some_atom)
 
 
 # ---- text ---------------------------------------------------------------------

@@ -1,0 +1,92 @@
+"""Reach-type certificates from the linearisation: V = s (x^T P x - c) (and, for RAR, the
+barrier x^T P' x - d) with the LQR controller, where the origin is an equilibrium inside
+the goal; the shape of P is chosen so that the sampled I and boundary of S are furthest
+apart. The seed is only a starting point: the kernel judges it like any candidate."""
+import torch
+
+import fossil_dsl
+from fossil_dsl.engine.learner import Learner
+from fossil_dsl.plan.compile import compile_spec
+
+# a damped double integrator: reach the goal from the left, below an obstacle that sits
+# between init and goal in x0 (the lines through its faces cross the way)
+RWA = """\
+state x0, x1
+input u0
+dynamics continuous {
+    x0' = x1
+    x1' = u0 - 0.2*x1
+}
+domain box([-3, -3], [3, 3])
+set init = box([-2, -0.3], [-1.5, 0.3])
+set goal = ball([0, 0], 0.3)
+set unsafe = box([-1, 1.5], [1, 3])
+prove from init: not unsafe until goal
+"""
+
+# an oscillator with a quadratic spring: reach `final` and stay there, avoiding a box
+RSWA = """\
+state x0, x1
+dynamics continuous {
+    x0' = x1
+    x1' = -x0 - 0.6*x1 + 0.1*x0^2
+}
+domain box([-2, -2], [2, 2])
+set init   = box([1, -0.2], [1.4, 0.2])
+set final  = ball([0, 0], 0.4)
+set unsafe = box([-2, 1.5], [-1.2, 2])
+prove from init: not unsafe until always final
+"""
+
+# a jerk-driven chain with damping: reach, avoid, remain
+RAR = """\
+state x0, x1, x2
+input u0
+dynamics continuous {
+    x0' = x1
+    x1' = x2
+    x2' = u0 - x2
+}
+domain box([-2, -2, -2], [2, 2, 2])
+set init = box([0.8, -0.1, -0.1], [1, 0.1, 0.1])
+set goal = ball([0, 0, 0], 0.3)
+set final = ball([0, 0, 0], 0.6)
+set unsafe = box([-2, -2, 1.5], [-1.5, 2, 2])
+prove from init: not unsafe until (goal and always final)
+"""
+
+
+def learner_for(text: str) -> Learner:
+    return Learner(compile_spec(fossil_dsl.loads(text)), torch.Generator().manual_seed(0))
+
+
+def test_the_seed_meets_every_sampled_condition():
+    for text in (RWA, RSWA):
+        learner = learner_for(text)
+        assert learner.seeded
+        V = learner.networks["V"]
+        assert (V(learner.samples["initial"]) <= 0).all()
+        assert (V(learner.samples["boundary"]) > 0).all()
+        loss, satisfied = learner.loss()
+        assert satisfied, float(loss)
+
+
+def test_the_rar_seed_sets_both_functions_and_the_controller():
+    learner = learner_for(RAR)
+    assert learner.seeded
+    B = learner.networks["B"]
+    assert (B(learner.samples["barrier_initial"]) <= 0).all()
+    assert (B(learner.samples["barrier_unsafe"]) > 0).all()
+    gain = learner.controller.output.weight @ learner.controller.linears[0].weight
+    assert gain.abs().sum() > 0  # the LQR gain, not torch's random start
+
+
+def test_no_seed_where_the_goal_misses_the_origin():
+    shifted = RSWA.replace("ball([0, 0], 0.4)", "ball([-0.8, 0], 0.3)")
+    assert not learner_for(shifted).seeded
+
+
+def test_seeded_reach_certificates_are_certified_in_the_first_iterations():
+    for text, most in ((RWA, 1), (RSWA, 1), (RAR, 10)):
+        result = fossil_dsl.synthesise(fossil_dsl.loads(text), seed=0, timeout=120)
+        assert result.certified and result.iterations <= most, result.reason
