@@ -112,3 +112,17 @@ def test_only_the_four_inequalities_are_read():
     odd = L.conjunction(L.Compare(">", NORM, E.ZERO), L.Compare("==", NORM, E.ZERO))
     assert "not a conjunction of polynomial comparisons" in refutation_problem(
         Refutation((F(1), F(1)), ZERO_SQUARE), odd, STATES)
+
+
+def test_conjuncts_that_are_not_comparisons_are_left_out():
+    """A disjunction among the conjuncts (x outside a box) gets no multiplier: refuting
+    the comparisons alone refutes the whole query, which asks for more."""
+    outside = L.disjunction(L.Compare(">=", E.Var("x0"), E.Num(F(1))),
+                            L.Compare(">=", E.Var("x1"), E.Num(F(1))))
+    query = L.conjunction(L.Compare(">", NORM, E.ZERO), outside,
+                          L.Compare(">=", E.neg(NORM), E.ZERO))
+    good = Refutation((F(1), F(1)), ZERO_SQUARE)
+    assert refutation_problem(good, query, STATES) is None
+    assert "2 multipliers for 1" in refutation_problem(
+        good, L.conjunction(outside, L.Compare(">", NORM, E.ZERO)), STATES)
+    assert "no comparison" in refutation_problem(good, outside, STATES)

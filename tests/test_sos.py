@@ -247,3 +247,30 @@ def test_refutations_the_kernel_found_itself_are_exported_and_rechecked(tmp_path
     assert (tmp_path / "obligations" / "relation-initial_and_unsafe.sos.json").exists()
     checks = recheck(tmp_path, timeout=10)
     assert all(c.reproved for c in checks), [(c.condition, c.reason) for c in checks]
+
+
+# four double integrators in a ring, one force each: LQR and its quadratic V are the
+# textbook answer, but Z3 gave no answer on "V > 0" in 8 variables within 50 s
+RING_OF_CARTS = """\
+state x0, x1, x2, x3, x4, x5, x6, x7
+input u0, u1, u2, u3
+dynamics continuous {
+    x0' = x1
+    x1' = u0 + 0.1*x2
+    x2' = x3
+    x3' = u1 + 0.1*x4
+    x4' = x5
+    x5' = u2 + 0.1*x6
+    x6' = x7
+    x7' = u3 + 0.1*x0
+}
+domain ball([0, 0, 0, 0, 0, 0, 0, 0], 1)
+prove stable
+"""
+
+
+def test_the_learning_loop_tries_refutations_first_from_six_states():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(RING_OF_CARTS), seed=0, timeout=120)
+    assert result.certified and result.iterations == 1, result.reason
+    solvers = {c.name: c.solver for c in result.conditions}
+    assert solvers["positive"] == solvers["decrease"] == "sum of squares (exact)", solvers

@@ -69,9 +69,25 @@ class Learner(ViolationSearch):
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V or B (and LQR controller) as the starting point
         self.seeded = linear.seed(plan, self.networks, self.controller, self.samples) \
-            or reach_seed.seed(plan, self.networks, self.controller, self.samples)
+            or self.seed_reach()
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
+
+    def seed_reach(self) -> bool:
+        """The first reach-type seed (reach_seed.py) that meets every condition on the
+        samples, with the closed loop's true field; else the one of least loss."""
+        best = None
+        for set_seed in reach_seed.candidates(self.plan, self.networks, self.controller,
+                                              self.samples):
+            set_seed()
+            loss, satisfied = self.loss()
+            if satisfied:
+                return True
+            if best is None or float(loss.detach()) < best[0]:
+                best = (float(loss.detach()), set_seed)
+        if best is not None:
+            best[1]()
+        return best is not None
 
     def restart(self) -> None:
         """New initial weights for every network, and a new optimiser; the samples (with

@@ -8,10 +8,11 @@ least s times x^T Q x, which the scale s makes exceed the plan's γ outside the 
 RAR the barrier B = x^T P' x - d of the same closed loop separates G from D \\ F.
 
 Which P fits is a question of shape: the ellipsoid {x^T P x <= c} must hold I and miss
-the boundary of S. The seed therefore tries several LQR weightings (which gain) and
-several decrease matrices Q (which P for that gain), and keeps the one whose sampled
-I and boundary are furthest apart in the ratio of their values. Nothing here is trusted:
-the seed is verified like any candidate, and learning starts from it where it fails.
+the boundary of S. For each of several LQR weightings (which gain), a small
+semidefinite program finds the Lyapunov matrix of that closed loop under which the
+sampled boundary lies furthest out, relative to the sampled I; the pair with the largest
+ratio is kept. Nothing here is trusted: the seed is verified like any candidate, and
+learning starts from it where it fails.
 """
 from __future__ import annotations
 
@@ -19,44 +20,61 @@ import numpy as np
 import torch
 
 from fossil_dsl.engine.evaluate import holds, state_env
-from fossil_dsl.engine.linear import (LEVEL_POSITION, _holds_a_quadratic, _is_linear,
-                                      _set_linear, _set_quadratic, closed_loop,
+from fossil_dsl.engine.linear import (LEVEL_POSITION, MAX_CONDITION, _holds_a_quadratic,
+                                      _is_linear, _set_linear, _set_quadratic, closed_loop,
                                       lyapunov_matrix, operating_point)
+from fossil_dsl.ir import polynomials
 from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.plan.certificates.rwa import GAMMA
 
 REACH_FORMS = ("reach while avoid", "reach", "reach and stay while avoid",
                "reach-avoid-remain")
 GAINS = 8  # LQR weightings tried (the first: identities)
-SHAPES = 24  # decrease matrices Q tried per gain (the first: I)
+SDP_SAMPLES = 300  # of each sampled set, at most, in the separating program
+LMI_MARGIN = 1e-3  # the program's decrease: A^T P + P A <= -this I (P's scale: 1 on I)
+MAX_TRACE = 1e4  # keeps the program bounded where I is thin
 WEIGHT_SPREAD = 1.0  # LQR weights drawn as 10^u, u uniform in [-spread, spread]
 MIN_RATIO = 1.05  # the sampled boundary must lie this factor beyond the sampled I
 DECREASE_MARGIN = 5.0  # the seed's linear decrease outside G: this many times γ
 
 
-def seed(plan, networks: dict, controller, samples: dict) -> bool:
-    """Set V (and B for RAR) and the controller to the best fitting quadratic seed;
-    whether it seeded."""
+def candidates(plan, networks: dict, controller, samples: dict) -> list:
+    """Seeds to try, best separated first: each a function that sets V (and B for RAR)
+    and the controller. Empty where no seed applies."""
     if plan.spec.property.form not in REACH_FORMS or not _fits(plan, networks, controller):
-        return False
+        return []
     operating = operating_point(plan.spec)
     if operating is None or not _origin_in_goal(plan):
-        return False
+        return []
     rng = np.random.default_rng(plan.options.seed)
-    best = None
+    discrete = plan.spec.time is TimeDomain.DISCRETE
+    found = []
     for A, K in _gains(plan, controller is not None, operating, rng):
-        for fit in _shapes(A, plan.spec.time is TimeDomain.DISCRETE, samples, rng):
-            if best is None or fit[0] > best[0]:
-                best = (*fit, K)
-    if best is None or best[0] < MIN_RATIO:
-        return False
-    _, v_part, b_part, K = best
-    _set_quadratic(networks["V"], *v_part)
-    if b_part is not None and "B" in networks:
-        _set_quadratic(networks["B"], *b_part)
-    if controller is not None:
-        _set_linear(controller, -K, operating)
-    return True
+        b_part = _barrier_part(A, discrete, samples)
+        for ratio, P, level in _fits_of_v(A, discrete, samples):
+            if ratio < MIN_RATIO:
+                continue
+            scale = _scale(P, A, discrete, level, samples.get("decrease"))
+            # where no quadratic B separates G from D \ F, V and the controller are
+            # still seeded and B is left to learning: such seeds come last
+            rank = (b_part is None or (b_part is not False and b_part[0] >= MIN_RATIO),
+                    ratio if not b_part else min(ratio, b_part[0]))
+            found.append((rank, (scale * P, scale * level),
+                          b_part if b_part and b_part[0] >= MIN_RATIO else None, K))
+    found.sort(key=lambda fit: fit[0], reverse=True)
+    return [_setter(networks, controller, v_part, b_part, K, operating)
+            for _, v_part, b_part, K in found]
+
+
+def _setter(networks, controller, v_part, b_part, K, operating):
+    def set_seed() -> None:
+        _set_quadratic(networks["V"], *v_part)
+        if b_part is not None:
+            _set_quadratic(networks["B"], *b_part[1:])
+        if controller is not None:
+            _set_linear(controller, -K, operating)
+    return set_seed
 
 
 def _fits(plan, networks: dict, controller) -> bool:
@@ -92,28 +110,104 @@ def _gains(plan, controlled: bool, operating, rng):
             yield found
 
 
-def _shapes(A: np.ndarray, discrete: bool, samples: dict, rng):
-    """(ratio, (P, c) for V, (P', d) or None for B) for decrease matrices I and random
-    positive definite ones."""
+def _fits_of_v(A: np.ndarray, discrete: bool, samples: dict):
+    """(ratio, P, level) of the Lyapunov matrix for Q = I and of the one that separates
+    the sampled I and boundary of S best, where they separate them."""
+    inside, outside = samples.get("initial"), samples.get("boundary")
+    for P in (lyapunov_matrix(A, discrete), separating_lyapunov(A, discrete, inside, outside)):
+        if P is not None:
+            ratio, level = _separation(P, inside, outside)
+            if level is not None:
+                yield ratio, P, level
+
+
+def _barrier_part(A: np.ndarray, discrete: bool, samples: dict):
+    """None without a barrier; else (ratio, P', d) of the better separating matrix for
+    G and D \\ F, or False where neither separates them."""
+    if "barrier_initial" not in samples:
+        return None
+    best = False
+    inside, outside = samples["barrier_initial"], samples["barrier_unsafe"]
+    for P in (lyapunov_matrix(A, discrete), separating_lyapunov(A, discrete, inside, outside)):
+        if P is not None:
+            ratio, level = _separation(P, inside, outside)
+            if level is not None and (best is False or ratio > best[0]):
+                best = (ratio, P, level)
+    return best
+
+
+def separating_lyapunov(A: np.ndarray, discrete: bool, inside, outside,
+                        seconds: float = 2.0) -> np.ndarray | None:
+    """P (largest eigenvalue 1) of a Lyapunov function of x' = Ax (x+ = Ax) whose
+    sampled `inside` lies in {x^T P x <= 1} and `outside` in {x^T P x >= t}, t as large
+    as possible: a semidefinite program (P, and W = -(A^T P + P A) - εI, both PSD)."""
+    if inside is None or outside is None or not len(inside) or not len(outside):
+        return None
+    inside, outside = (_thinned(np.asarray(points.detach() if isinstance(points, torch.Tensor)
+                                           else points, dtype=np.float64))
+                       for points in (inside, outside))
     n = len(A)
-    for index in range(SHAPES):
-        factor = np.eye(n) if index == 0 else rng.standard_normal((n, n))
-        Q = factor @ factor.T + 0.1 * np.eye(n)
-        P = lyapunov_matrix(A, discrete, Q / np.linalg.norm(Q, 2))
-        if P is None:
-            continue
-        ratio, level = _separation(P, samples.get("initial"), samples.get("boundary"))
-        if level is None:
-            continue
-        scale = _scale(P, A, discrete, level, samples.get("decrease"))
-        v_part, b_part = (scale * P, scale * level), None
-        if "barrier_initial" in samples:
-            b_ratio, b_level = _separation(P, samples["barrier_initial"],
-                                           samples["barrier_unsafe"])
-            if b_level is None:
-                continue
-            ratio, b_part = min(ratio, b_ratio), (P, b_level)
-        yield ratio, v_part, b_part
+    program = Program(n)
+    basis = polynomials.monomials(n, 1, 1)
+    entries = program.gram(basis, of=lambda p: {})
+    slack = program.gram(basis, of=lambda p: {})
+    variable = {(i, j): v for v, i, j in entries}
+    variable.update({(j, i): v for v, i, j in entries})
+    change = _change_matrix(A, discrete)  # entries of the change's matrix, linear in P
+    for (v, i, j), (w, _, _) in zip(entries, slack):
+        row = {w: 1.0}
+        for (k, l), weight in change[i][j].items():
+            row[variable[k, l]] = row.get(variable[k, l], 0.0) + weight
+        program.equalities.append((row, -LMI_MARGIN * (i == j)))
+    t = program.scalar()
+    for x in inside:
+        program.at_most.append((_quadratic_row(x, entries), 1.0))
+    for x in outside:
+        row = {v: -c for v, c in _quadratic_row(x, entries).items()}
+        row[t] = 1.0
+        program.at_most.append((row, 0.0))
+    program.at_most.append(({v: 1.0 for v, i, j in entries if i == j}, MAX_TRACE))
+    x = program.solve({t: -1.0}, seconds)
+    if x is None:
+        return None
+    P = program.matrix(x, entries, n)
+    eigenvalues = np.linalg.eigvalsh(P)
+    if eigenvalues[0] <= 0 or eigenvalues[-1] / eigenvalues[0] > MAX_CONDITION:
+        return None
+    return P / eigenvalues[-1]
+
+
+def _change_matrix(A: np.ndarray, discrete: bool) -> list[list[dict]]:
+    """For each (i, j): the entry (i, j) of A^T P + P A (A^T P A - P) as weights on P's
+    entries (k, l)."""
+    n = len(A)
+    table = [[{} for _ in range(n)] for _ in range(n)]
+    for i in range(n):
+        for j in range(n):
+            entry = table[i][j]
+            if discrete:
+                for k in range(n):
+                    for l in range(n):
+                        _add(entry, (k, l), A[k, i] * A[l, j])
+                _add(entry, (i, j), -1.0)
+            else:
+                for k in range(n):
+                    _add(entry, (k, j), A[k, i])
+                    _add(entry, (i, k), A[k, j])
+    return table
+
+
+def _add(entry: dict, key: tuple[int, int], weight: float) -> None:
+    key = (min(key), max(key))
+    entry[key] = entry.get(key, 0.0) + weight
+
+
+def _quadratic_row(x: np.ndarray, entries) -> dict[int, float]:
+    return {v: x[i] * x[j] * (1.0 if i == j else 2.0) for v, i, j in entries}
+
+
+def _thinned(points: np.ndarray) -> np.ndarray:
+    return points[:: max(1, len(points) // SDP_SAMPLES)]
 
 
 def _values(P: np.ndarray, points) -> np.ndarray:

@@ -14,6 +14,7 @@ from fossil_dsl.kernel import Verdict, judge, not_certified
 from fossil_dsl.outputs.result import Result, build_result, claim_of
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.fallback import FallbackBackend
+from fossil_dsl.solvers.positivstellensatz import BEFORE_Z3_FROM
 from fossil_dsl.ir.spec import CheckedSpec
 
 # re-exported: specs built in Python are part of this API
@@ -48,7 +49,15 @@ def _judge(plan: Plan, outcome) -> Verdict:
 
 
 def _backend(plan: Plan):
+    """The plan's verifier, raced by its fallback where it has one. For polynomial
+    problems a sum-of-squares refutation is tried too: before the solvers from
+    BEFORE_Z3_FROM states on, else by the fallback before its own procedure (so only
+    once Z3 has not answered at once: a 4-state quadratic condition stalled Z3 for 60 s)."""
+    from fossil_dsl.solvers.sos_refutation import RefutationFirst
     backend = registry.load(plan.verifier, plan.options.delta)
+    polynomial, many = plan.verifier == "z3", len(plan.states) >= BEFORE_Z3_FROM
     if plan.fallback:
-        backend = FallbackBackend(backend, registry.load(plan.fallback, plan.options.delta))
-    return backend
+        fallback = registry.load(plan.fallback, plan.options.delta)
+        backend = FallbackBackend(backend, RefutationFirst(fallback)
+                                  if polynomial and not many else fallback)
+    return RefutationFirst(backend) if polynomial and many else backend

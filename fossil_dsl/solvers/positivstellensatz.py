@@ -1,7 +1,7 @@
 """An exact check of a sum-of-squares refutation of an obligation: no solver, only
 rational arithmetic.
 
-The obligation's query must be a conjunction of polynomial comparisons; each is read as
+The obligation's query must be a conjunction; each of its polynomial comparisons is read as
 h_j(x) >= 0 or h_j(x) > 0 (h_j: one side minus the other). A refutation gives, in the
 query's order, a multiplier for each comparison: none, a rational constant c >= 0 (or
 c h^(m-1), making the term c h^m), or a sum of squares m(x)^T G m(x) (G rational and
@@ -62,20 +62,28 @@ class Refutation:
 
 
 def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynomial, bool]]:
-    """(h, strict) for each comparison h >= 0 / h > 0 of a conjunctive query; raises
-    ValueError where the query is not a conjunction of polynomial comparisons."""
+    """(h, strict) for each comparison h >= 0 / h > 0 among the query's conjuncts;
+    raises ValueError where one is not polynomial, or where there is none.
+
+    Conjuncts that are not comparisons (a disjunction, such as "outside the unsafe box")
+    are left out: a refutation of the other conjuncts proves that no point satisfies
+    them, and so none satisfies the whole query."""
     found = []
     for atom in conjuncts(query):
         if isinstance(atom, L.Not) and isinstance(atom.arg, L.Compare) \
                 and atom.arg.relation in NEGATED:
             inner = atom.arg
             atom = L.Compare(NEGATED[inner.relation], inner.left, inner.right)
-        if not isinstance(atom, L.Compare) or atom.relation not in NEGATED:
+        if not isinstance(atom, L.Compare):
+            continue
+        if atom.relation not in NEGATED:
             raise ValueError(f"not an inequality: {atom}")
         larger, smaller = (atom.left, atom.right) if atom.relation in (">", ">=") \
             else (atom.right, atom.left)
         found.append((P.polynomial(add(larger, neg(smaller)), states),
                       atom.relation in ("<", ">")))
+    if not found:
+        raise ValueError("the query has no comparison among its conjuncts")
     return found
 
 
