@@ -51,17 +51,17 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
     discrete = plan.spec.time is TimeDomain.DISCRETE
     found = []
     for A, K in _gains(plan, controller is not None, operating, rng):
-        b_part = _barrier_part(A, discrete, samples)
-        for ratio, P, level in _fits_of_v(A, discrete, samples):
+        barrier = _barrier_part(A, discrete, samples) if "B" in networks else None
+        for ratio, P, level in _separations(A, discrete, samples.get("initial"),
+                                            samples.get("boundary")):
             if ratio < MIN_RATIO:
                 continue
             scale = _scale(P, A, discrete, level, samples.get("decrease"))
             # where no quadratic B separates G from D \ F, V and the controller are
             # still seeded and B is left to learning: such seeds come last
-            rank = (b_part is None or (b_part is not False and b_part[0] >= MIN_RATIO),
-                    ratio if not b_part else min(ratio, b_part[0]))
-            found.append((rank, (scale * P, scale * level),
-                          b_part if b_part and b_part[0] >= MIN_RATIO else None, K))
+            rank = (barrier is not None or "B" not in networks,
+                    ratio if barrier is None else min(ratio, barrier[0]))
+            found.append((rank, (scale * P, scale * level), barrier, K))
     found.sort(key=lambda fit: fit[0], reverse=True)
     return [_setter(networks, controller, v_part, b_part, K, operating)
             for _, v_part, b_part, K in found]
@@ -110,10 +110,9 @@ def _gains(plan, controlled: bool, operating, rng):
             yield found
 
 
-def _fits_of_v(A: np.ndarray, discrete: bool, samples: dict):
+def _separations(A: np.ndarray, discrete: bool, inside, outside):
     """(ratio, P, level) of the Lyapunov matrix for Q = I and of the one that separates
-    the sampled I and boundary of S best, where they separate them."""
-    inside, outside = samples.get("initial"), samples.get("boundary")
+    the sampled sets best, where they separate them."""
     for P in (lyapunov_matrix(A, discrete), separating_lyapunov(A, discrete, inside, outside)):
         if P is not None:
             ratio, level = _separation(P, inside, outside)
@@ -122,18 +121,11 @@ def _fits_of_v(A: np.ndarray, discrete: bool, samples: dict):
 
 
 def _barrier_part(A: np.ndarray, discrete: bool, samples: dict):
-    """None without a barrier; else (ratio, P', d) of the better separating matrix for
-    G and D \\ F, or False where neither separates them."""
-    if "barrier_initial" not in samples:
-        return None
-    best = False
-    inside, outside = samples["barrier_initial"], samples["barrier_unsafe"]
-    for P in (lyapunov_matrix(A, discrete), separating_lyapunov(A, discrete, inside, outside)):
-        if P is not None:
-            ratio, level = _separation(P, inside, outside)
-            if level is not None and (best is False or ratio > best[0]):
-                best = (ratio, P, level)
-    return best
+    """(ratio, P', d) of the better matrix separating the sampled G and D \\ F by at
+    least MIN_RATIO, or None."""
+    found = [fit for fit in _separations(A, discrete, samples["barrier_initial"],
+                                         samples["barrier_unsafe"]) if fit[0] >= MIN_RATIO]
+    return max(found, key=lambda fit: fit[0], default=None)
 
 
 def separating_lyapunov(A: np.ndarray, discrete: bool, inside, outside,
