@@ -11,6 +11,7 @@ does not suffice. Nothing here is trusted: the seed is verified like any candida
 """
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 
 import numpy as np
@@ -153,9 +154,9 @@ def seed(plan, networks: dict[str, Network], controller: Network | None,
     form = plan.spec.property.form
     network = networks.get("V" if form in STABLE_FORMS else "B")
     if form not in STABLE_FORMS + BARRIER_FORMS or network is None \
-            or not _holds_a_quadratic(network, len(plan.states)):
+            or not holds_a_quadratic(network, len(plan.states)):
         return False
-    if controller is not None and not _is_linear(controller, len(plan.controller.inputs)):
+    if controller is not None and not is_linear(controller, len(plan.controller.inputs)):
         return False
     operating = None
     if form in BARRIER_FORMS:  # the origin need not be an equilibrium without control
@@ -168,39 +169,51 @@ def seed(plan, networks: dict[str, Network], controller: Network | None,
     P, K = found
     level = 0.0
     if form in BARRIER_FORMS:
-        level = _barrier_level(P, samples.get("initial"), samples.get("unsafe"))
+        level = separation(P, samples.get("initial"), samples.get("unsafe"))[1]
         if level is None:
             return False
-    _set_quadratic(network, P, level)
+    set_quadratic(network, P, level)
     if controller is not None:
-        _set_linear(controller, -K, operating)
+        set_linear(controller, -K, operating)
     return True
 
 
-def _barrier_level(P: np.ndarray, initial, unsafe) -> float | None:
-    """A level c with x^T P x < c on the sampled I and > c on the sampled U, or None."""
-    if initial is None or unsafe is None or not len(initial) or not len(unsafe):
-        return None
-    matrix = torch.as_tensor(P, dtype=torch.float64)
-    inside = float(torch.einsum("bi,ij,bj->b", initial, matrix, initial).max())
-    outside = float(torch.einsum("bi,ij,bj->b", unsafe, matrix, unsafe).min())
-    if not 0 <= inside < outside:
-        return None
-    return inside + LEVEL_POSITION * (outside - inside)
+def separation(P: np.ndarray, inside, outside) -> tuple[float, float | None]:
+    """(how many times the largest x^T P x on the sampled `inside` goes into the
+    smallest on the sampled `outside` (infinite where the first is 0), a level c
+    between them), or (0, None) where no level separates them."""
+    if inside is None or outside is None or not len(inside) or not len(outside):
+        return 0.0, None
+    high = float(quadratic_values(P, inside).max())
+    low = float(quadratic_values(P, outside).min())
+    if not 0 <= high < low:
+        return 0.0, None
+    return (low / high if high > 0 else math.inf), high + LEVEL_POSITION * (low - high)
 
 
-def _holds_a_quadratic(network: Network, n: int) -> bool:
+def quadratic_values(P: np.ndarray, points) -> np.ndarray:
+    """x^T P x at each point (numpy, from torch tensors or arrays)."""
+    points = as_array(points)
+    return np.einsum("bi,ij,bj->b", points, P, points)
+
+
+def as_array(points) -> np.ndarray:
+    return np.asarray(points.detach() if isinstance(points, torch.Tensor) else points,
+                      dtype=np.float64)
+
+
+def holds_a_quadratic(network: Network, n: int) -> bool:
     return (len(network.linears) == 1 and network.activations[0].name == "square"
             and network.linears[0].out_features >= n)
 
 
-def _is_linear(network: Network, outputs: int) -> bool:
+def is_linear(network: Network, outputs: int) -> bool:
     return (network.divisors is None
             and all(a.name == "linear" for a in network.activations)
             and len(network.linears) == 1 and network.linears[0].out_features >= outputs)
 
 
-def _set_quadratic(network: Network, P: np.ndarray, level: float = 0.0) -> None:
+def set_quadratic(network: Network, P: np.ndarray, level: float = 0.0) -> None:
     """First layer: the rows of L^T (P = L L^T), then zero rows' worth of output, so
     V(x) = |L^T x|^2 - level = x^T P x - level exactly; the spare units start with output
     weight 0. A layer that sees x / d (input divisors) holds L^T d."""
@@ -216,7 +229,7 @@ def _set_quadratic(network: Network, P: np.ndarray, level: float = 0.0) -> None:
         _set_output_bias(network, [-level])
 
 
-def _set_linear(network: Network, gain: np.ndarray, offset=None) -> None:
+def set_linear(network: Network, gain: np.ndarray, offset=None) -> None:
     """k(x) = gain x + offset: the hidden layer holds the gain, the output passes it
     through and adds the offset."""
     m = gain.shape[0]

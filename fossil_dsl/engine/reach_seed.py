@@ -17,12 +17,12 @@ learning starts from it where it fails.
 from __future__ import annotations
 
 import numpy as np
-import torch
 
 from fossil_dsl.engine.evaluate import holds, state_env
-from fossil_dsl.engine.linear import (LEVEL_POSITION, MAX_CONDITION, _holds_a_quadratic,
-                                      _is_linear, _set_linear, _set_quadratic, closed_loop,
-                                      lyapunov_matrix, operating_point)
+from fossil_dsl.engine.linear import (MAX_CONDITION, as_array, closed_loop, holds_a_quadratic,
+                                      is_linear, lyapunov_matrix, operating_point,
+                                      quadratic_values, separation, set_linear,
+                                      set_quadratic)
 from fossil_dsl.ir import polynomials
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.solvers.sdp import Program
@@ -69,21 +69,21 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
 
 def _setter(networks, controller, v_part, b_part, K, operating):
     def set_seed() -> None:
-        _set_quadratic(networks["V"], *v_part)
+        set_quadratic(networks["V"], *v_part)
         if b_part is not None:
-            _set_quadratic(networks["B"], *b_part[1:])
+            set_quadratic(networks["B"], *b_part[1:])
         if controller is not None:
-            _set_linear(controller, -K, operating)
+            set_linear(controller, -K, operating)
     return set_seed
 
 
 def _fits(plan, networks: dict, controller) -> bool:
     n = len(plan.states)
-    if "V" not in networks or not _holds_a_quadratic(networks["V"], n):
+    if "V" not in networks or not holds_a_quadratic(networks["V"], n):
         return False
-    if "B" in networks and not _holds_a_quadratic(networks["B"], n):
+    if "B" in networks and not holds_a_quadratic(networks["B"], n):
         return False
-    return controller is None or _is_linear(controller, len(plan.controller.inputs))
+    return controller is None or is_linear(controller, len(plan.controller.inputs))
 
 
 def _origin_in_goal(plan) -> bool:
@@ -115,7 +115,7 @@ def _separations(A: np.ndarray, discrete: bool, inside, outside):
     the sampled sets best, where they separate them."""
     for P in (lyapunov_matrix(A, discrete), separating_lyapunov(A, discrete, inside, outside)):
         if P is not None:
-            ratio, level = _separation(P, inside, outside)
+            ratio, level = separation(P, inside, outside)
             if level is not None:
                 yield ratio, P, level
 
@@ -135,9 +135,7 @@ def separating_lyapunov(A: np.ndarray, discrete: bool, inside, outside,
     as possible: a semidefinite program (P, and W = -(A^T P + P A) - εI, both PSD)."""
     if inside is None or outside is None or not len(inside) or not len(outside):
         return None
-    inside, outside = (_thinned(np.asarray(points.detach() if isinstance(points, torch.Tensor)
-                                           else points, dtype=np.float64))
-                       for points in (inside, outside))
+    inside, outside = _thinned(as_array(inside)), _thinned(as_array(outside))
     n = len(A)
     program = Program(n)
     basis = polynomials.monomials(n, 1, 1)
@@ -202,23 +200,6 @@ def _thinned(points: np.ndarray) -> np.ndarray:
     return points[:: max(1, len(points) // SDP_SAMPLES)]
 
 
-def _values(P: np.ndarray, points) -> np.ndarray:
-    points = np.asarray(points.detach() if isinstance(points, torch.Tensor) else points,
-                        dtype=np.float64)
-    return np.einsum("bi,ij,bj->b", points, P, points)
-
-
-def _separation(P: np.ndarray, inside, outside) -> tuple[float, float | None]:
-    """(how many times the smallest x^T P x on `outside` exceeds the largest on
-    `inside`, a level between them), or (0, None) where none separates them."""
-    if inside is None or outside is None or not len(inside) or not len(outside):
-        return 0.0, None
-    high, low = _values(P, inside).max(), _values(P, outside).min()
-    if not 0 < high < low:
-        return 0.0, None
-    return low / high, high + LEVEL_POSITION * (low - high)
-
-
 def _scale(P: np.ndarray, A: np.ndarray, discrete: bool, level: float, points) -> float:
     """s such that the linearised change of s x^T P x is at most -DECREASE_MARGIN γ on
     the sampled S \\ G where x^T P x <= level (1 where no sample is there). The change
@@ -227,9 +208,9 @@ def _scale(P: np.ndarray, A: np.ndarray, discrete: bool, level: float, points) -
     if points is None or not len(points):
         return 1.0
     change = A.T @ P @ A - P if discrete else A.T @ P + P @ A
-    inside = _values(P, points) <= level
+    inside = quadratic_values(P, points) <= level
     if not inside.any():
         return 1.0
-    nearest = _values(np.eye(len(P)), points)[inside].min()
+    nearest = quadratic_values(np.eye(len(P)), points)[inside].min()
     slowest = -np.linalg.eigvalsh((change + change.T) / 2)[-1] * nearest
     return max(1.0, DECREASE_MARGIN * float(GAMMA) / slowest) if slowest > 0 else 1.0

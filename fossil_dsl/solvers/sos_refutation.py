@@ -185,9 +185,10 @@ REFUTATION_SHARE = 0.25  # of a query's time, at most, for the refutation before
 
 class RefutationFirst:
     """A sum-of-squares refutation first, then `backend` with the time left: for
-    polynomial problems in BEFORE_Z3_FROM or more states, where Z3 stalls on what a
-    small semidefinite program proves at once (an 8-state quadratic's positivity: no
-    answer from Z3 in 50 s). Counterexamples still come from `backend` alone."""
+    polynomial problems, where Z3 stalls on what a small semidefinite program proves at
+    once (an 8-state quadratic's positivity: no answer from Z3 in 50 s). The learning
+    loop puts it before Z3 from BEFORE_Z3_FROM states, else before the fallback's own
+    procedure (frontends/api.py). Counterexamples still come from `backend` alone."""
 
     def __init__(self, backend):
         self.backend = backend
