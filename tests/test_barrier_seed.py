@@ -2,14 +2,20 @@
 closed loop with inputs), and the kernel's stronger guarantee ("never leaves D") only
 where its further obligation is proved."""
 import json
+from pathlib import Path
 
 import torch
 
 import fossil_dsl
 from fossil_dsl.engine.learner import Learner
 from fossil_dsl.engine.linear import local_certificate
+from fossil_dsl.kernel.obligations import file_stem
+from fossil_dsl.kernel.prove import SUM_OF_SQUARES
+from fossil_dsl.outputs import recheck as rechecking
 from fossil_dsl.outputs.recheck import recheck
 from fossil_dsl.plan.compile import compile_spec
+
+STABLE = Path(__file__).resolve().parent.parent / "specs" / "stability_continuous.fsl"
 
 # four weakly coupled decaying modes; the level sets of x^T P x are far from round
 DECAY = """\
@@ -64,10 +70,49 @@ def test_the_seeded_barrier_separates_the_sampled_sets():
     assert (B(learner.samples["unsafe"]) > 0).all()
 
 
-def test_no_seed_where_the_origin_is_not_an_equilibrium():
+def test_where_the_origin_is_not_an_equilibrium_the_seed_is_centred_on_one():
     shifted = DECAY.replace("d' = -0.3*d", "d' = -0.3*d + 0.01")
     plan = compile_spec(fossil_dsl.loads(shifted))
-    assert not Learner(plan, torch.Generator().manual_seed(0)).seeded
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    assert learner.seeded
+    equilibrium = torch.tensor([[0.0, 0.0, 0.0, 0.01 / 0.3]], dtype=torch.float64,
+                               requires_grad=True)
+    value = learner.networks["B"](equilibrium)
+    gradient, = torch.autograd.grad(value.sum(), equilibrium)
+    assert gradient.abs().max() < 1e-9  # the quadratic's centre
+    assert value < learner.networks["B"](torch.zeros(1, 4, dtype=torch.float64))
+
+
+# I lies away from the origin: an ellipse round the origin that holds I also holds -I,
+# which lies outside D; one round I's middle need not leave D
+AWAY = """\
+state x, y
+input u, v
+dynamics continuous {
+    x' = x*(1 - x - 0.5*y) + u
+    y' = y*(1 - y - 0.8*x) + v
+}
+domain box([-0.5, -0.5], [3, 3])
+set init   = box([1, 1], [1.4, 1.4])
+set unsafe = box([2.2, 2.2], [2.6, 2.6])
+prove from init: always not unsafe
+"""
+
+
+def test_a_seed_round_the_middle_of_i_keeps_its_zero_level_inside_the_domain():
+    plan = compile_spec(fossil_dsl.loads(AWAY))
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    assert learner.seeded
+    boundary = torch.tensor([[-0.5, 1.2], [3, 1.2], [1.2, -0.5], [1.2, 3], [-0.5, -0.5]],
+                            dtype=torch.float64)
+    assert (learner.networks["B"](boundary) > 0).all()
+    middle = torch.tensor([[1.2, 1.2]], dtype=torch.float64)
+    # the controller holds the middle of I as an equilibrium of the closed loop
+    assert torch.allclose(torch.stack(learner.field(middle)), torch.zeros(2, 1,
+                          dtype=torch.float64), atol=1e-9)
+    result = fossil_dsl.synthesise(plan.spec, seed=0, timeout=60)
+    assert result.certified, result.reason
+    assert result.kernel.strengthened == "never leaves D"
 
 
 def test_seeded_barriers_are_certified_at_once_and_never_leave_the_domain(tmp_path):
@@ -145,3 +190,32 @@ def test_the_controller_holds_the_input_that_makes_the_origin_an_equilibrium():
     assert torch.allclose(at_origin, torch.tensor([[-0.5, 0.0]], dtype=torch.float64))
     result = fossil_dsl.synthesise(plan.spec, seed=0, timeout=60)
     assert result.certified, result.reason
+
+
+# Z3 proves the cart's conditions in the run (no refutation is exported)
+def test_a_result_saved_over_another_leaves_nothing_of_it(tmp_path):
+    first = fossil_dsl.synthesise(fossil_dsl.load(STABLE), seed=0)  # proved by refutations
+    first.save(tmp_path)
+    assert list((tmp_path / "obligations").glob("*.sos.json"))
+    second = fossil_dsl.synthesise(fossil_dsl.loads(CART), seed=0, timeout=60)
+    assert second.certified
+    second.save(tmp_path)
+    left = {p.name.removesuffix(".sos.json")
+            for p in (tmp_path / "obligations").glob("*.sos.json")}
+    assert left == {file_stem(name) for name in second.refutations}
+    assert not (tmp_path / "obligations" / "condition-decrease.smt2").exists()
+    assert all(c.reproved for c in recheck(tmp_path, timeout=30))
+
+
+def test_without_cvc5_polynomial_obligations_are_rechecked_by_a_refutation(tmp_path,
+                                                                          monkeypatch):
+    result = fossil_dsl.synthesise(fossil_dsl.loads(CART), seed=0, timeout=60)
+    assert result.certified
+    result.save(tmp_path)
+    installed = rechecking.registry.is_installed
+    monkeypatch.setattr(rechecking.registry, "is_installed",
+                        lambda name: name != "cvc5" and installed(name))
+    checks = recheck(tmp_path, timeout=30)
+    assert all(c.reproved for c in checks), checks
+    by_refutation = [c for c in checks if c.proved_by == "z3" and c.solver == SUM_OF_SQUARES]
+    assert any(c.condition.startswith("condition-") for c in by_refutation), checks

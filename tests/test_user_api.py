@@ -388,3 +388,4 @@ def test_a_bespoke_domain_without_a_box_is_refused():
         box = None
     with pytest.raises(fossil_dsl.BuildError, match="needs a `box`"):
         built(domain=Anywhere())
+

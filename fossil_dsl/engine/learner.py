@@ -12,7 +12,7 @@ import time
 
 import torch
 
-from fossil_dsl.engine import linear, reach_seed
+from fossil_dsl.engine import linear, reach_seed, safety_seed
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
 from fossil_dsl.engine.levels import initial_samples, level_value
 from fossil_dsl.engine.loss import GUARD_BAND, condition_loss, guard_mask, placeholders
@@ -68,26 +68,32 @@ class Learner(ViolationSearch):
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V or B (and LQR controller) as the starting point
-        self.seeded = linear.seed(plan, self.networks, self.controller, self.samples) \
-            or self.seed_reach()
+        self.seeded = linear.seed(plan, self.networks, self.controller) \
+            or self.seed_from(safety_seed.candidates(plan, self.networks, self.controller,
+                                                     self.samples)) \
+            or self.seed_from(reach_seed.candidates(plan, self.networks, self.controller,
+                                                    self.samples))
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
 
-    def seed_reach(self) -> bool:
-        """The first reach-type seed (reach_seed.py) that meets every condition on the
-        samples, with the closed loop's true field; else the one of least loss."""
-        best = None
-        for set_seed in reach_seed.candidates(self.plan, self.networks, self.controller,
-                                              self.samples):
+    def seed_from(self, candidates) -> bool:
+        """Of (preferred, set_seed) pairs, best first: the first preferred seed that meets
+        every condition on the samples (with the closed loop's true field), else the first
+        other seed that does, else the one of least loss. Whether it seeded."""
+        best = satisfying = None
+        for preferred, set_seed in candidates:
             set_seed()
             loss, satisfied = self.loss()
-            if satisfied:
+            if satisfied and preferred:
                 return True
+            if satisfied and satisfying is None:
+                satisfying = set_seed
             if best is None or float(loss.detach()) < best[0]:
                 best = (float(loss.detach()), set_seed)
-        if best is not None:
-            best[1]()
-        return best is not None
+        chosen = satisfying or (best[1] if best is not None else None)
+        if chosen is not None:
+            chosen()
+        return chosen is not None
 
     def restart(self) -> None:
         """New initial weights for every network, and a new optimiser; the samples (with

@@ -25,7 +25,6 @@ from fossil_dsl.ir.enclosure import enclose
 from fossil_dsl.ir.spec import CheckedSpec, TimeDomain
 
 STABLE_FORMS = ("stability", "region of attraction", "stable while avoid")
-BARRIER_FORMS = ("safety",)
 # where between the largest x^T P x on I and the smallest on U (sampled) the barrier's
 # zero level goes: low, since the quadratic's decrease is surest near the origin
 LEVEL_POSITION = 0.25
@@ -33,10 +32,10 @@ OPERATING_STEPS = 20
 MAX_CONDITION = 1e6  # a P this ill-conditioned would not survive rounding to decimals
 
 
-def jacobians(spec: CheckedSpec, inputs=None) -> tuple[np.ndarray, np.ndarray] | None:
-    """A = df/dx and B = df/du at x = 0 and u = `inputs` (default 0), or None where a
-    derivative is not a finite number there."""
-    origin = _point(spec, inputs)
+def jacobians(spec: CheckedSpec, inputs=None, state=None) -> tuple[np.ndarray, np.ndarray] | None:
+    """A = df/dx and B = df/du at x = `state` (default 0) and u = `inputs` (default 0),
+    or None where a derivative is not a finite number there."""
+    origin = _point(spec, inputs, state)
     try:
         rows = [[_value_at(derivative(f, v), origin) for v in (*spec.states, *spec.inputs)]
                 for f in spec.dynamics]
@@ -49,30 +48,61 @@ def jacobians(spec: CheckedSpec, inputs=None) -> tuple[np.ndarray, np.ndarray] |
     return matrix[:, :n], matrix[:, n:]
 
 
-def _point(spec: CheckedSpec, inputs=None) -> dict[str, E.Expr]:
+def _point(spec: CheckedSpec, inputs=None, state=None) -> dict[str, E.Expr]:
     values = [0.0] * len(spec.inputs) if inputs is None else inputs
-    point = {name: E.ZERO for name in spec.states}
+    where = [0.0] * len(spec.states) if state is None else state
+    point = {name: E.Num(Fraction(float(x))) for name, x in zip(spec.states, where)}
     point.update({name: E.Num(Fraction(float(v))) for name, v in zip(spec.inputs, values)})
     return point
 
 
-def operating_point(spec: CheckedSpec) -> np.ndarray | None:
-    """Inputs u* that make the origin an equilibrium, f(0, u*) = 0 (Gauss-Newton from
-    u = 0; an empty vector without inputs), or None where none is found."""
+def operating_point(spec: CheckedSpec, state=None) -> np.ndarray | None:
+    """Inputs u* that make `state` (default the origin) an equilibrium, f(x, u*) = 0 (x+
+    = x in discrete time; Gauss-Newton from u = 0; an empty vector without inputs), or
+    None where none is found."""
     u = np.zeros(len(spec.inputs))
     for _ in range(OPERATING_STEPS):
-        try:
-            residual = np.array([_value_at(f, _point(spec, u)) for f in spec.dynamics])
-        except (E.ExprError, ValueError, ZeroDivisionError):
+        residual = _residual(spec, u, state)
+        if residual is None:
             return None
         if np.abs(residual).max(initial=0.0) < 1e-10:
             return u
-        found = jacobians(spec, u)
+        found = jacobians(spec, u, state)
         if found is None or not u.size:
             return None
-        step = np.linalg.lstsq(found[1], residual, rcond=None)[0]
-        u = u - step
+        u = u - np.linalg.lstsq(found[1], residual, rcond=None)[0]
     return None
+
+
+def equilibrium(spec: CheckedSpec, start) -> np.ndarray | None:
+    """An equilibrium of the system with every input 0 found by Newton's method from
+    `start`, or None where it does not converge."""
+    x = np.asarray(start, dtype=float)
+    n = len(x)
+    for _ in range(OPERATING_STEPS):
+        residual = _residual(spec, None, x)
+        if residual is None or not np.all(np.isfinite(residual)):
+            return None
+        if np.abs(residual).max(initial=0.0) < 1e-10:
+            return x
+        found = jacobians(spec, None, x)
+        if found is None:
+            return None
+        A = found[0] - np.eye(n) if spec.time is TimeDomain.DISCRETE else found[0]
+        x = x - np.linalg.lstsq(A, residual, rcond=None)[0]
+    return None
+
+
+def _residual(spec: CheckedSpec, inputs, state) -> np.ndarray | None:
+    """f(x, u), minus x in discrete time (zero at an equilibrium)."""
+    point = _point(spec, inputs, state)
+    try:
+        values = np.array([_value_at(f, point) for f in spec.dynamics])
+    except (E.ExprError, ValueError, ZeroDivisionError):
+        return None
+    if spec.time is TimeDomain.DISCRETE:
+        values = values - (np.zeros(len(values)) if state is None else np.asarray(state))
+    return values
 
 
 def _value_at(expr: E.Expr, origin) -> float:
@@ -98,12 +128,12 @@ def local_certificate(spec: CheckedSpec, controlled: bool, inputs=None):
 
 
 def closed_loop(spec: CheckedSpec, controlled: bool, inputs=None, state_weight=None,
-                input_weight=None):
-    """(A - B K, K): the linearisation at the origin closed by the LQR gain for the
-    weights (identities by default; K None without control), or None where it is not
-    stable (not stabilisable) or has no finite Jacobian."""
+                input_weight=None, state=None):
+    """(A - B K, K): the linearisation at `state` (default the origin) closed by the LQR
+    gain for the weights (identities by default; K None without control), or None where
+    it is not stable (not stabilisable) or has no finite Jacobian."""
     from scipy import linalg
-    found = jacobians(spec, inputs)
+    found = jacobians(spec, inputs, state)
     if found is None:
         return None
     A, B = found
@@ -146,35 +176,23 @@ def lyapunov_matrix(A: np.ndarray, discrete: bool, decrease=None) -> np.ndarray 
     return P / eigenvalues[-1]
 
 
-def seed(plan, networks: dict[str, Network], controller: Network | None,
-         samples: dict) -> bool:
-    """Where the networks can hold them exactly: for a stable-type property, V = x^T P x;
-    for safety, B = x^T P x - c with c between its values on I and on U (from the
-    samples); and the controller -K x. Whether it seeded."""
-    form = plan.spec.property.form
-    network = networks.get("V" if form in STABLE_FORMS else "B")
-    if form not in STABLE_FORMS + BARRIER_FORMS or network is None \
+def seed(plan, networks: dict[str, Network], controller: Network | None) -> bool:
+    """Where the networks can hold them exactly, for a stable-type property: V = x^T P x
+    and the controller -K x (safety and reach-type seeds: safety_seed.py, reach_seed.py).
+    Whether it seeded."""
+    network = networks.get("V")
+    if plan.spec.property.form not in STABLE_FORMS or network is None \
             or not holds_a_quadratic(network, len(plan.states)):
         return False
     if controller is not None and not is_linear(controller, len(plan.controller.inputs)):
         return False
-    operating = None
-    if form in BARRIER_FORMS:  # the origin need not be an equilibrium without control
-        operating = operating_point(plan.spec)
-        if operating is None or (operating.any() and controller.zero_at_origin):
-            return False
-    found = local_certificate(plan.spec, controller is not None, operating)
+    found = local_certificate(plan.spec, controller is not None)
     if found is None:
         return False
     P, K = found
-    level = 0.0
-    if form in BARRIER_FORMS:
-        level = separation(P, samples.get("initial"), samples.get("unsafe"))[1]
-        if level is None:
-            return False
-    set_quadratic(network, P, level)
+    set_quadratic(network, P)
     if controller is not None:
-        set_linear(controller, -K, operating)
+        set_linear(controller, -K)
     return True
 
 
@@ -213,11 +231,14 @@ def is_linear(network: Network, outputs: int) -> bool:
             and len(network.linears) == 1 and network.linears[0].out_features >= outputs)
 
 
-def set_quadratic(network: Network, P: np.ndarray, level: float = 0.0) -> None:
+def set_quadratic(network: Network, P: np.ndarray, level: float = 0.0, centre=None) -> None:
     """First layer: the rows of L^T (P = L L^T), then zero rows' worth of output, so
     V(x) = |L^T x|^2 - level = x^T P x - level exactly; the spare units start with output
-    weight 0. A layer that sees x / d (input divisors) holds L^T d."""
+    weight 0. A layer that sees x / d (input divisors) holds L^T d. With a `centre` c
+    (the network must have biases), the first layer's biases are -L^T c: V(x) =
+    (x - c)^T P (x - c) - level."""
     factor = torch.as_tensor(np.linalg.cholesky(P).T, dtype=torch.float64)
+    shift = None if centre is None else -factor @ torch.as_tensor(centre, dtype=torch.float64)
     if network.divisors is not None:
         factor = factor * network.input_divisor
     n = len(P)
@@ -227,6 +248,8 @@ def set_quadratic(network: Network, P: np.ndarray, level: float = 0.0) -> None:
         output.zero_()
         output[0, :n] = 1.0
         _set_output_bias(network, [-level])
+        if shift is not None:
+            network.linears[0].bias[:n] = shift
 
 
 def set_linear(network: Network, gain: np.ndarray, offset=None) -> None:

@@ -19,29 +19,22 @@ from __future__ import annotations
 import numpy as np
 
 from fossil_dsl.engine.evaluate import holds, state_env
-from fossil_dsl.engine.linear import (MAX_CONDITION, as_array, closed_loop, holds_a_quadratic,
-                                      is_linear, lyapunov_matrix, operating_point,
-                                      quadratic_values, separation, set_linear,
-                                      set_quadratic)
-from fossil_dsl.ir import polynomials
+from fossil_dsl.engine.linear import (holds_a_quadratic, is_linear, operating_point,
+                                      quadratic_values, set_linear, set_quadratic)
+from fossil_dsl.engine.quadratic_shapes import lqr_gains, separations
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.plan.certificates.rwa import GAMMA
 
 REACH_FORMS = ("reach while avoid", "reach", "reach and stay while avoid",
                "reach-avoid-remain")
-GAINS = 8  # LQR weightings tried (the first: identities)
-SDP_SAMPLES = 300  # of each sampled set, at most, in the separating program
-LMI_MARGIN = 1e-3  # the program's decrease: A^T P + P A <= -this I (P's scale: 1 on I)
-MAX_TRACE = 1e4  # keeps the program bounded where I is thin
-WEIGHT_SPREAD = 1.0  # LQR weights drawn as 10^u, u uniform in [-spread, spread]
 MIN_RATIO = 1.05  # the sampled boundary must lie this factor beyond the sampled I
 DECREASE_MARGIN = 5.0  # the seed's linear decrease outside G: this many times γ
 
 
 def candidates(plan, networks: dict, controller, samples: dict) -> list:
-    """Seeds to try, best separated first: each a function that sets V (and B for RAR)
-    and the controller. Empty where no seed applies."""
+    """Seeds to try, best separated first: (True, a function that sets V (and B for RAR)
+    and the controller) (every one preferred alike, see Learner.seed_from). Empty where
+    no seed applies."""
     if plan.spec.property.form not in REACH_FORMS or not _fits(plan, networks, controller):
         return []
     operating = operating_point(plan.spec)
@@ -50,9 +43,9 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
     rng = np.random.default_rng(plan.options.seed)
     discrete = plan.spec.time is TimeDomain.DISCRETE
     found = []
-    for A, K in _gains(plan, controller is not None, operating, rng):
+    for A, K in lqr_gains(plan.spec, controller is not None, operating, rng):
         barrier = _barrier_part(A, discrete, samples) if "B" in networks else None
-        for ratio, P, level in _separations(A, discrete, samples.get("initial"),
+        for ratio, P, level in separations(A, discrete, samples.get("initial"),
                                             samples.get("boundary")):
             if ratio < MIN_RATIO:
                 continue
@@ -63,7 +56,7 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
                     ratio if barrier is None else min(ratio, barrier[0]))
             found.append((rank, (scale * P, scale * level), barrier, K))
     found.sort(key=lambda fit: fit[0], reverse=True)
-    return [_setter(networks, controller, v_part, b_part, K, operating)
+    return [(True, _setter(networks, controller, v_part, b_part, K, operating))
             for _, v_part, b_part, K in found]
 
 
@@ -97,107 +90,12 @@ def _origin_in_goal(plan) -> bool:
     return bool(holds(goal.contains_formula(plan.states), state_env(plan.states, origin), 1)[0])
 
 
-def _gains(plan, controlled: bool, operating, rng):
-    """(closed-loop A, K) for LQR with identity weights, then random diagonal ones."""
-    tries = GAINS if controlled and len(plan.spec.inputs) else 1
-    n, m = len(plan.states), len(plan.spec.inputs)
-    for index in range(tries):
-        weights = (None, None) if index == 0 else (
-            np.diag(10 ** rng.uniform(-WEIGHT_SPREAD, WEIGHT_SPREAD, n)),
-            np.diag(10 ** rng.uniform(-WEIGHT_SPREAD, WEIGHT_SPREAD, m)))
-        found = closed_loop(plan.spec, controlled, operating, *weights)
-        if found is not None:
-            yield found
-
-
-def _separations(A: np.ndarray, discrete: bool, inside, outside):
-    """(ratio, P, level) of the Lyapunov matrix for Q = I and of the one that separates
-    the sampled sets best, where they separate them."""
-    for P in (lyapunov_matrix(A, discrete), separating_lyapunov(A, discrete, inside, outside)):
-        if P is not None:
-            ratio, level = separation(P, inside, outside)
-            if level is not None:
-                yield ratio, P, level
-
-
 def _barrier_part(A: np.ndarray, discrete: bool, samples: dict):
     """(ratio, P', d) of the better matrix separating the sampled G and D \\ F by at
     least MIN_RATIO, or None."""
-    found = [fit for fit in _separations(A, discrete, samples["barrier_initial"],
+    found = [fit for fit in separations(A, discrete, samples["barrier_initial"],
                                          samples["barrier_unsafe"]) if fit[0] >= MIN_RATIO]
     return max(found, key=lambda fit: fit[0], default=None)
-
-
-def separating_lyapunov(A: np.ndarray, discrete: bool, inside, outside,
-                        seconds: float = 2.0) -> np.ndarray | None:
-    """P (largest eigenvalue 1) of a Lyapunov function of x' = Ax (x+ = Ax) whose
-    sampled `inside` lies in {x^T P x <= 1} and `outside` in {x^T P x >= t}, t as large
-    as possible: a semidefinite program (P, and W = -(A^T P + P A) - εI, both PSD)."""
-    if inside is None or outside is None or not len(inside) or not len(outside):
-        return None
-    inside, outside = _thinned(as_array(inside)), _thinned(as_array(outside))
-    n = len(A)
-    program = Program(n)
-    basis = polynomials.monomials(n, 1, 1)
-    entries = program.gram(basis, of=lambda p: {})
-    slack = program.gram(basis, of=lambda p: {})
-    variable = {(i, j): v for v, i, j in entries}
-    variable.update({(j, i): v for v, i, j in entries})
-    change = _change_matrix(A, discrete)  # entries of the change's matrix, linear in P
-    for (v, i, j), (w, _, _) in zip(entries, slack):
-        row = {w: 1.0}
-        for (k, l), weight in change[i][j].items():
-            row[variable[k, l]] = row.get(variable[k, l], 0.0) + weight
-        program.equalities.append((row, -LMI_MARGIN * (i == j)))
-    t = program.scalar()
-    for x in inside:
-        program.at_most.append((_quadratic_row(x, entries), 1.0))
-    for x in outside:
-        row = {v: -c for v, c in _quadratic_row(x, entries).items()}
-        row[t] = 1.0
-        program.at_most.append((row, 0.0))
-    program.at_most.append(({v: 1.0 for v, i, j in entries if i == j}, MAX_TRACE))
-    x = program.solve({t: -1.0}, seconds)
-    if x is None:
-        return None
-    P = program.matrix(x, entries, n)
-    eigenvalues = np.linalg.eigvalsh(P)
-    if eigenvalues[0] <= 0 or eigenvalues[-1] / eigenvalues[0] > MAX_CONDITION:
-        return None
-    return P / eigenvalues[-1]
-
-
-def _change_matrix(A: np.ndarray, discrete: bool) -> list[list[dict]]:
-    """For each (i, j): the entry (i, j) of A^T P + P A (A^T P A - P) as weights on P's
-    entries (k, l)."""
-    n = len(A)
-    table = [[{} for _ in range(n)] for _ in range(n)]
-    for i in range(n):
-        for j in range(n):
-            entry = table[i][j]
-            if discrete:
-                for k in range(n):
-                    for l in range(n):
-                        _add(entry, (k, l), A[k, i] * A[l, j])
-                _add(entry, (i, j), -1.0)
-            else:
-                for k in range(n):
-                    _add(entry, (k, j), A[k, i])
-                    _add(entry, (i, k), A[k, j])
-    return table
-
-
-def _add(entry: dict, key: tuple[int, int], weight: float) -> None:
-    key = (min(key), max(key))
-    entry[key] = entry.get(key, 0.0) + weight
-
-
-def _quadratic_row(x: np.ndarray, entries) -> dict[int, float]:
-    return {v: x[i] * x[j] * (1.0 if i == j else 2.0) for v, i, j in entries}
-
-
-def _thinned(points: np.ndarray) -> np.ndarray:
-    return points[:: max(1, len(points) // SDP_SAMPLES)]
 
 
 def _scale(P: np.ndarray, A: np.ndarray, discrete: bool, level: float, points) -> float:

@@ -13,9 +13,17 @@ from fossil_dsl.outputs import onnx_export
 from fossil_dsl.outputs.summary import summary_text
 
 
+# what an earlier result in the same folder may have left that this one does not rewrite
+OWN_FILES = ("obligations/*.smt2", "obligations/*.sos.json", "certificate.onnx",
+             "controller.onnx", "networks.pt")
+
+
 def write_artefacts(result: Result, directory: str | Path) -> Path:
     out = Path(directory)
     (out / "obligations").mkdir(parents=True, exist_ok=True)
+    for pattern in OWN_FILES:  # a stale refutation or obligation would be re-checked
+        for path in out.glob(pattern):
+            path.unlink()
     (out / "result.json").write_text(json.dumps(result.to_json(), indent=2) + "\n")
     (out / "certificate.txt").write_text(summary_text(result) + "\n")
     for name, text in result.obligations.items():
