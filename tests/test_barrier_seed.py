@@ -83,18 +83,20 @@ def test_where_the_origin_is_not_an_equilibrium_the_seed_is_centred_on_one():
     assert value < learner.networks["B"](torch.zeros(1, 4, dtype=torch.float64))
 
 
-# I lies away from the origin: an ellipse round the origin that holds I also holds -I,
-# which lies outside D; one round I's middle need not leave D
+# BarrierBench bb23 with the domain its script draws round the sets: I lies away from
+# the origin, and an ellipsoid round the origin that holds I crosses D's lower faces; one
+# round I's middle, held there by the controller's bias, need not
 AWAY = """\
-state x, y
-input u, v
+state x1, x2, x3
+input u0, u1, u2
 dynamics continuous {
-    x' = x*(1 - x - 0.5*y) + u
-    y' = y*(1 - y - 0.8*x) + v
+    x1' = 0.5 - 0.2*x1 + u0
+    x2' = 0.1*x1 - 0.15*x2 + u1
+    x3' = 0.05*x2 - 0.1*x3 + u2
 }
-domain box([-0.5, -0.5], [3, 3])
-set init   = box([1, 1], [1.4, 1.4])
-set unsafe = box([2.2, 2.2], [2.6, 2.6])
+domain box([-1, -1.25, -1.05], [7, 5.75, 4.35])
+set init   = box([1, 0.5, 0.3], [1.5, 1, 0.7])
+set unsafe = box([4, 3, 2], [5, 4, 3])
 prove from init: always not unsafe
 """
 
@@ -103,12 +105,12 @@ def test_a_seed_round_the_middle_of_i_keeps_its_zero_level_inside_the_domain():
     plan = compile_spec(fossil_dsl.loads(AWAY))
     learner = Learner(plan, torch.Generator().manual_seed(0))
     assert learner.seeded
-    boundary = torch.tensor([[-0.5, 1.2], [3, 1.2], [1.2, -0.5], [1.2, 3], [-0.5, -0.5]],
-                            dtype=torch.float64)
+    boundary = torch.tensor([[-1, 0.75, 0.5], [1.25, -1.25, 0.5], [1.25, 0.75, -1.05],
+                             [-1, -1.25, -1.05]], dtype=torch.float64)
     assert (learner.networks["B"](boundary) > 0).all()
-    middle = torch.tensor([[1.2, 1.2]], dtype=torch.float64)
+    middle = torch.tensor([[1.25, 0.75, 0.5]], dtype=torch.float64)
     # the controller holds the middle of I as an equilibrium of the closed loop
-    assert torch.allclose(torch.stack(learner.field(middle)), torch.zeros(2, 1,
+    assert torch.allclose(torch.stack(learner.field(middle)), torch.zeros(3, 1,
                           dtype=torch.float64), atol=1e-9)
     result = fossil_dsl.synthesise(plan.spec, seed=0, timeout=60)
     assert result.certified, result.reason

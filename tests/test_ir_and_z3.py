@@ -277,6 +277,21 @@ def test_cvc5_is_stopped_at_its_deadline_even_when_it_ignores_its_limit(monkeypa
     assert time.monotonic() - started < 3
 
 
+def test_cvc5_is_stopped_when_another_solver_of_a_race_has_answered(monkeypatch):
+    import threading
+    import time
+    from fossil_dsl.solvers import cvc5_backend
+    monkeypatch.setattr(cvc5_backend, "_solve", lambda *args: time.sleep(600))
+    stop = threading.Event()
+    threading.Timer(0.3, stop.set).start()
+    started = time.monotonic()
+    answer = cvc5_backend.Cvc5Backend().check_text(
+        "(set-logic QF_NRA)\n(declare-const x Real)\n(assert (> x 0))\n(check-sat)\n", 60.0,
+        stop=stop)
+    assert answer.status.value == "unknown" and answer.reason == "stopped"
+    assert time.monotonic() - started < 2
+
+
 def test_cvc5_answers_from_its_child_process():
     from fossil_dsl.solvers import cvc5_backend
     text = "(set-logic QF_NRA)\n(declare-const x Real)\n(assert (> (* x x) 2))\n(check-sat)\n"
@@ -284,3 +299,23 @@ def test_cvc5_answers_from_its_child_process():
     assert sat.status.value == "sat" and sat.model["x"] ** 2 > 2
     unsat = cvc5_backend.Cvc5Backend().check_text(text.replace("> (* x x) 2", "< (* x x) -1"), 5.0)
     assert unsat.status.value == "unsat"
+
+
+def test_cvc5_races_for_polynomial_counterexamples_that_z3_misses():
+    # specs/probe/g04's decrease condition for a learned V (4 states, quadratic): Z3 and
+    # the interval search each ran 30 s without an answer; CVC5 has a model at once
+    import time
+    from pathlib import Path
+    from fossil_dsl import load
+    from fossil_dsl.frontends.api import _backend
+    from fossil_dsl.plan.compile import compile_spec
+    from fossil_dsl.solvers.smtlib_reader import read_script
+    root = Path(__file__).resolve().parent
+    query = read_script((root / "data" / "g04_decrease.smt2").read_text())
+    plan = compile_spec(load(root.parent / "specs" / "probe" / "g04_planar_rwa.fsl"))
+    started = time.monotonic()
+    answer = _backend(plan).check(query.formula, query.variables, 20.0)
+    assert answer.status.value == "sat" and answer.solver == "cvc5"
+    assert time.monotonic() - started < 10
+    point = {v: E.Num(answer.model[v]) for v in query.variables}
+    assert L.truth(L.substitute(query.formula, point)) is True

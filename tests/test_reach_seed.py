@@ -106,3 +106,56 @@ def test_seeded_reach_certificates_are_certified_in_the_first_iterations():
     for text in (RWA, RSWA, SPIRAL_RAR):
         result = fossil_dsl.synthesise(fossil_dsl.loads(text), seed=0, timeout=120)
         assert result.certified and result.iterations == 1, result.reason
+
+
+# four states, two inputs: the thin ellipsoid that holds I and its mirror image reaches
+# into the corners of D, which 4-dimensional boundary samples seldom visit
+PLANAR = """\
+state x0, x1, x2, x3
+input u0, u1
+dynamics continuous {
+    x0' = x2
+    x1' = x3
+    x2' = u0
+    x3' = u1
+}
+domain box([-3, -3, -3, -3], [3, 3, 3, 3])
+set init = box([-2, -2, -0.1, -0.1], [-1.8, -1.8, 0.1, 0.1])
+set goal = ball([0, 0, 0, 0], 0.3)
+set unsafe = box([0.5, -3, -3, -3], [1, -1.5, 3, 3])
+prove from init: not unsafe until goal
+"""
+
+
+def test_the_level_stays_below_the_quadratic_on_the_boxes_exact_boundary():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(PLANAR), seed=0, timeout=120)
+    assert result.certified and result.iterations == 1, result.reason
+
+
+def test_box_floors_bound_the_quadratic_on_the_faces_and_on_the_box():
+    import numpy as np
+    from fossil_dsl.engine.quadratic_shapes import boundary_floor, set_floor
+    from fossil_dsl.ir.sets import Box
+    from fossil_dsl.ir.expr import Num
+    from fractions import Fraction
+    rng = np.random.default_rng(0)
+    factor = rng.normal(size=(3, 3))
+    P = factor @ factor.T + 0.1 * np.eye(3)
+    box = Box(tuple(Num(Fraction(v)) for v in (-1, -2, -1)),
+              tuple(Num(Fraction(v)) for v in (2, 1, 3)))
+    centre = np.array([0.2, -0.3, 0.5])
+    floor = boundary_floor(P, box, centre)
+    # points on the ellipsoid (x - c)^T P (x - c) = floor lie in the box, and one of them
+    # on a face: the floor is the largest level whose ellipsoid stays inside
+    directions = rng.normal(size=(20000, 3))
+    scale = np.sqrt(floor / np.einsum("bi,ij,bj->b", directions, P, directions))
+    points = centre + directions * scale[:, None]
+    low, high = np.array([-1, -2, -1]), np.array([2, 1, 3])
+    assert np.all(points >= low - 1e-9) and np.all(points <= high + 1e-9)
+    assert np.min(np.minimum(points - low, high - points)) < 0.02
+    # the smallest value over a box away from the centre, against a dense sample of it
+    away = Box(tuple(Num(Fraction(v)) for v in (1, 1, 1)), tuple(Num(Fraction(v)) for v in (2, 3, 2)))
+    inside = rng.uniform([1, 1, 1], [2, 3, 2], size=(200000, 3)) - centre
+    sampled = np.einsum("bi,ij,bj->b", inside, P, inside).min()
+    assert set_floor(P, away, centre) <= sampled + 1e-9
+    assert set_floor(P, away, centre) >= sampled - 0.05 * sampled

@@ -27,12 +27,8 @@ def violation_of(claim: L.Formula, env) -> torch.Tensor:
 def guard_mask(guard: L.Formula, env, batch: int, band: float) -> torch.Tensor:
     if guard == L.TRUE:
         return torch.ones(batch, dtype=torch.bool)
-    # the band is measured in the guard's own functions (B for B(x) = 0): the size of
-    # dB/dt made it so wide that it held B's minimum, where dB/dt = 0
-    functions = {k: v for k, v in env.items() if k.startswith("$")
-                 and isinstance(v, torch.Tensor) and v.dim() > 0}
-    own = L.free_vars(guard) & functions.keys()
-    scale = max((float(functions[k].detach().abs().mean()) for k in own or functions),
+    scale = max((float(v.detach().abs().mean()) for k, v in env.items()
+                 if k.startswith("$") and isinstance(v, torch.Tensor) and v.dim() > 0),
                 default=1.0)
     detached = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
     return holds(guard, detached, batch, band * scale)

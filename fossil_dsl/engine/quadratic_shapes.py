@@ -4,11 +4,14 @@ as far inside {x^T P x <= 1} as possible relative to another (a small semidefini
 program). Used by the safety and reach-type seeds; nothing here is trusted."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from fossil_dsl.engine.linear import (MAX_CONDITION, as_array, closed_loop, lyapunov_matrix,
                                       separation)
 from fossil_dsl.ir import polynomials
+from fossil_dsl.ir import sets as S
 from fossil_dsl.solvers.sdp import Program
 
 GAINS = 8  # LQR weightings tried (the first: identities)
@@ -31,13 +34,15 @@ def lqr_gains(spec, controlled: bool, operating, rng, state=None):
             yield found
 
 
-def separations(A: np.ndarray, discrete: bool, inside, outside, shapes=None):
+def separations(A: np.ndarray, discrete: bool, inside, outside, shapes=None, floor=None):
     """(ratio, P, level) of the Lyapunov matrix for Q = I and of the one that separates
-    the sampled sets best (or of the `shapes` given), where they separate them."""
+    the sampled sets best (or of the `shapes` given), where they separate them; with a
+    `floor` (P -> a lower bound of x^T P x on the outside set, or None), the samples'
+    smallest value is lowered to it."""
     for shape in shapes or SHAPES:
         P = shape(A, discrete, inside, outside)
         if P is not None:
-            ratio, level = separation(P, inside, outside)
+            ratio, level = separation(P, inside, outside, floor(P) if floor else None)
             if level is not None:
                 yield ratio, P, level
 
@@ -120,3 +125,104 @@ def _thinned(points: np.ndarray) -> np.ndarray:
 
 
 SHAPES = (plain_lyapunov, separating_lyapunov)
+
+
+def floor_outside(P: np.ndarray, inner, outer, centre: np.ndarray) -> float | None:
+    """A lower bound (or, for a box, the computed minimum) of (x - c)^T P (x - c) where
+    the ellipsoid {(x - c)^T P (x - c) <= t} would leave `inner` (a convex set round c,
+    through its boundary) or meet `outer`; None where a shape is not one worked out
+    here. Sampled sets miss the corners of a box in 4 or more dimensions, where an
+    ellipsoid chosen on samples alone was seen to cross the domain's boundary."""
+    parts = [boundary_floor(P, inner, centre) if inner is not None else math.inf,
+             set_floor(P, outer, centre) if outer is not None else math.inf]
+    return None if any(p is None for p in parts) else min(parts)
+
+
+def boundary_floor(P: np.ndarray, region, centre: np.ndarray) -> float | None:
+    """The smallest value of the quadratic on the boundary of a box or ball that holds
+    the centre (from below), of their intersections and differences; else None."""
+    region = _unnamed(region)
+    if isinstance(region, S.Difference):
+        return floor_outside(P, region.left, region.right, centre)
+    if isinstance(region, S.Complement):  # D minus the operand
+        return floor_outside(P, region.domain, region.operand, centre)
+    if isinstance(region, S.Intersection):
+        parts = [boundary_floor(P, side, centre) for side in (region.left, region.right)]
+        return None if None in parts else min(parts)
+    bounds = _numbers(region)
+    if bounds is None:
+        return None
+    if isinstance(region, S.Box):
+        low, high = bounds
+        if not np.all((low <= centre) & (centre <= high)):
+            return None
+        spread = np.diag(np.linalg.inv(P))  # the ellipsoid's extent along axis i: sqrt(t s_i)
+        return float(min(np.minimum(centre - low, high - centre) ** 2 / spread))
+    if isinstance(region, S.Ball):
+        middle, radius = bounds
+        gap = radius - np.linalg.norm(centre - middle)
+        return float(np.linalg.eigvalsh(P)[0] * gap ** 2) if gap > 0 else None
+    return None
+
+
+def set_floor(P: np.ndarray, region, centre: np.ndarray) -> float | None:
+    """The smallest value of the quadratic on a box (a convex program solved
+    numerically), a ball (from below), the outside of a ball within the domain (its
+    sphere), and unions of these; else None."""
+    region = _unnamed(region)
+    if isinstance(region, S.Union):
+        parts = [set_floor(P, side, centre) for side in (region.left, region.right)]
+        return None if None in parts else min(parts)
+    if isinstance(region, S.Complement):
+        return boundary_floor(P, region.operand, centre)
+    bounds = _numbers(region)
+    if bounds is None:
+        return None
+    if isinstance(region, S.Box):
+        return _box_minimum(P, centre, *bounds)
+    if isinstance(region, S.Ball):
+        middle, radius = bounds
+        gap = np.linalg.norm(centre - middle) - radius
+        return float(np.linalg.eigvalsh(P)[0] * gap ** 2) if gap > 0 else 0.0
+    return None
+
+
+def _box_minimum(P, centre, low, high, steps: int = 500) -> float:
+    """min of (x - c)^T P (x - c) over the box, by projected gradient steps of 1 / (2
+    λmax(P)) from the point of the box nearest c (a convex problem; scipy.optimize
+    would cost 0.6 s of import for this)."""
+    x = np.clip(centre, low, high)
+    if np.allclose(x, centre):
+        return 0.0
+    step = 0.5 / np.linalg.eigvalsh(P)[-1]
+    for _ in range(steps):
+        moved = np.clip(x - step * 2 * P @ (x - centre), low, high)
+        if np.allclose(moved, x, rtol=0, atol=1e-12):
+            break
+        x = moved
+    return float((x - centre) @ P @ (x - centre))
+
+
+def _unnamed(region):
+    while isinstance(region, S.Named):
+        region = region.value
+    return region
+
+
+def _numbers(region):
+    """A box's (low, high) or a ball's (centre, radius) as floats, or None."""
+    try:
+        if isinstance(region, S.Box):
+            return (np.array([float(_value(v)) for v in region.lower]),
+                    np.array([float(_value(v)) for v in region.upper]))
+        if isinstance(region, S.Ball):
+            return np.array([float(_value(v)) for v in region.centre]), float(_value(region.radius))
+    except (TypeError, ValueError):
+        return None
+    return None
+
+
+def _value(expr):
+    from fossil_dsl.ir.enclosure import enclose
+    low, high = enclose(expr)
+    return (low + high) / 2

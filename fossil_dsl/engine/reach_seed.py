@@ -16,12 +16,14 @@ learning starts from it where it fails.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from fossil_dsl.engine.evaluate import holds, state_env
 from fossil_dsl.engine.linear import (holds_a_quadratic, is_linear, operating_point,
                                       quadratic_values, set_linear, set_quadratic)
-from fossil_dsl.engine.quadratic_shapes import lqr_gains, separations
+from fossil_dsl.engine.quadratic_shapes import boundary_floor, lqr_gains, separations
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.rwa import GAMMA
 
@@ -45,8 +47,10 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
     found = []
     for A, K in lqr_gains(plan.spec, controller is not None, operating, rng):
         barrier = _barrier_part(A, discrete, samples) if "B" in networks else None
+        floor = functools.partial(boundary_floor, region=plan.spec.property.role("safe"),
+                                  centre=np.zeros(len(plan.states)))
         for ratio, P, level in separations(A, discrete, samples.get("initial"),
-                                            samples.get("boundary")):
+                                           samples.get("boundary"), floor=floor):
             if ratio < MIN_RATIO:
                 continue
             scale = _scale(P, A, discrete, level, samples.get("decrease"))

@@ -16,11 +16,14 @@ Nothing here is trusted: every seed is verified like any candidate.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from fossil_dsl.engine.linear import (as_array, equilibrium, holds_a_quadratic, is_linear,
                                       operating_point, set_linear, set_quadratic)
-from fossil_dsl.engine.quadratic_shapes import SHAPES, lqr_gains, separations
+from fossil_dsl.engine.quadratic_shapes import (SHAPES, floor_outside, lqr_gains, separations,
+                                               set_floor)
 from fossil_dsl.engine.sampling import sample
 from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
@@ -48,15 +51,26 @@ def candidates(plan, networks: dict, controller, samples: dict):
     fenced = unsafe if boundary is None else np.concatenate([unsafe, boundary])
     discrete = plan.spec.time is TimeDomain.DISCRETE
     loops = sorted(_closed_loops(plan, network, controller, inside), key=lambda loop: loop[0])
-    passes = ((fenced, True), (unsafe, False)) if boundary is not None else ((unsafe, True),)
-    for outside, preferred in passes:
+    domain, unsafe_set = plan.spec.domain, plan.spec.property.role("unsafe")
+    passes = ((fenced, domain, True), (unsafe, None, False)) if boundary is not None \
+        else ((unsafe, None, True),)
+    for outside, fence, preferred in passes:
         for shape in SHAPES:  # the plain Lyapunov matrix's surer decrease first
             for weighting, centre, operating, A, K in loops:
+                floor = functools.partial(_floor, fence=fence, unsafe=unsafe_set, centre=centre)
                 for _, P, level in separations(A, discrete, inside - centre,
-                                               outside - centre, (shape,)):
+                                               outside - centre, (shape,), floor):
                     scale = _scale(P, A, discrete, level, plan.options.margin)
                     yield preferred, _setter(network, controller, scale * P, scale * level,
                                              centre, K, operating)
+
+
+def _floor(P, fence, unsafe, centre):
+    """A lower bound of (x - c)^T P (x - c) on U (and on the boundary of D where the seed
+    must stay inside it), or None."""
+    if fence is None:
+        return set_floor(P, unsafe, centre) if unsafe is not None else None
+    return floor_outside(P, fence, unsafe, centre)
 
 
 def _scale(P: np.ndarray, A: np.ndarray, discrete: bool, level: float, margin: float) -> float:

@@ -38,7 +38,11 @@ from fossil_dsl.syntax.parser import parse_expression, parse_source
 # what it finds is checked in exact arithmetic (4- to 6-state flow conditions that Z3
 # proved in the run were left UNKNOWN by CVC5 and the interval search at 10 s each).
 POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "dreal")
-TRANSCENDENTAL_ORDER = ("dreal", "interval", "cvc5")
+# Arb's ball arithmetic (solvers/arb_backend.py) is the other procedure for a
+# transcendental query the interval verifier proved: CVC5 left four BarrierBench flow
+# conditions with sin and cos UNKNOWN at 60 s, which Arb refutes in 0.7 to 9 s.
+TRANSCENDENTAL_ORDER = ("dreal", "interval", "arb", "cvc5")
+RECHECK_ONLY = (SUM_OF_SQUARES, "arb")  # procedures that are not verifiers of a run
 
 
 class RecheckError(FslError):
@@ -215,6 +219,9 @@ def _backend(name: str):
     if name == SUM_OF_SQUARES:
         from fossil_dsl.solvers.sos_refutation import SosBackend
         return SosBackend()
+    if name == "arb":
+        from fossil_dsl.solvers.arb_backend import ArbBackend
+        return ArbBackend()
     return registry.load(name)
 
 
@@ -226,7 +233,7 @@ def other_solvers(used: str, formula: L.Formula) -> list[str]:
     if not L.free_vars(formula):  # a fact about numbers: no box to search
         order = ("z3", "cvc5")
     return [n for n in order if n != used
-            and (n == SUM_OF_SQUARES or registry.is_installed(n))]
+            and (n in RECHECK_ONLY or registry.is_installed(n))]
 
 
 def _reason(answer) -> str:

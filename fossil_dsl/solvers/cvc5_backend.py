@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import multiprocessing
 import signal
+import time
 from fractions import Fraction
 from typing import Sequence
 
@@ -20,8 +21,8 @@ class Cvc5Backend:
 
     def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
               stop=None) -> Answer:
-        """`stop` is not looked at: CVC5's API cannot be interrupted, so a query ends
-        at its own time limit."""
+        """CVC5's API cannot be interrupted; its child process is killed when `stop` is
+        set (another solver of a race has answered)."""
         missing = _functions(formula) & NOT_IN_CVC5
         if missing:
             return Answer(Status.UNKNOWN, reason="CVC5 has no " + ", ".join(sorted(missing)))
@@ -29,9 +30,10 @@ class Cvc5Backend:
             text = query_text(formula, variables)
         except UnsupportedTheory as exc:
             return Answer(Status.UNKNOWN, reason=str(exc))
-        return self.check_text(text, timeout, variables)
+        return self.check_text(text, timeout, variables, stop)
 
-    def check_text(self, text: str, timeout: float, variables: Sequence[str] = ()) -> Answer:
+    def check_text(self, text: str, timeout: float, variables: Sequence[str] = (),
+                   stop=None) -> Answer:
         """In a child process that is killed at the deadline: CVC5's nonlinear module
         (libpoly's root isolation in its coverings procedure) was seen running for 30
         minutes past its `tlimit-per` of 60 s, holding a benchmark run and a recheck."""
@@ -44,8 +46,10 @@ class Cvc5Backend:
         child.start()
         send.close()
         try:
-            if receive.poll(timeout + GRACE_SECONDS):
+            if _wait(receive, time.monotonic() + timeout + GRACE_SECONDS, stop):
                 return receive.recv()
+            if stop is not None and stop.is_set():
+                return Answer(Status.UNKNOWN, reason="stopped")
             return Answer(Status.UNKNOWN, reason=f"timeout: CVC5 ran past {timeout:g} s "
                           "and was stopped")
         except EOFError:
@@ -59,6 +63,20 @@ class Cvc5Backend:
 
 
 GRACE_SECONDS = 2.0  # past the time limit, for CVC5 to stop by itself and reply
+STOP_POLL = 0.02  # s between looks at the stop event
+
+
+def _wait(receive, deadline: float, stop) -> bool:
+    """Whether the answer arrived before the deadline (False at once when stopped)."""
+    if stop is None:
+        return receive.poll(max(0.0, deadline - time.monotonic()))
+    while not stop.is_set():
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return False
+        if receive.poll(min(STOP_POLL, left)):
+            return True
+    return False
 
 
 def _answer_into(connection, text: str, timeout: float, variables) -> None:

@@ -1,0 +1,261 @@
+"""A second refutation procedure for transcendental queries, on Arb's ball arithmetic
+(python-flint), sharing no code with the interval verifier (codac/IBEX).
+
+`fossilc recheck` re-proves each obligation with a procedure other than the one that
+proved it in the run. For a query with sin or exp that the interval verifier proved,
+the only other installed solver was CVC5, which seldom decides such queries: this
+procedure is that other one. It bisects a box that the query itself bounds and refutes
+each piece by enclosures: a box is refuted when some conjunct's comparison cannot
+hold anywhere in it (Arb's enclosures contain every value of the expression there, and
+a strict comparison is read as the non-strict one, which only enlarges the set). UNSAT
+when every piece of the cover is refuted; otherwise UNKNOWN (never SAT: it looks for no
+counterexamples).
+
+The starting box comes from the query's own conjuncts: bounds `c <= x`, and
+comparisons `sum a_i (x_i - c_i)^2 <= r` (a ball or ellipsoid with axis-parallel axes),
+each worked out in exact rationals and rounded outwards. A variable no conjunct bounds
+makes the answer UNKNOWN: the search covers bounded boxes only.
+"""
+from __future__ import annotations
+
+import math
+import time
+from fractions import Fraction
+from typing import Sequence
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.solvers.api import Answer, Status
+
+SMALLEST = 1e-12  # a box this narrow (relative to the start) that is not refuted: give up
+BELOW, ABOVE = ("<", "<="), (">", ">=")
+
+
+class ArbBackend:
+    name = "arb"
+
+    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
+              stop=None) -> Answer:
+        import flint
+        names = sorted(set(variables) | L.free_vars(formula))
+        box = starting_box(formula, names)
+        if box is None:
+            return Answer(Status.UNKNOWN, reason="the query does not bound every variable")
+        if any(lo > hi for lo, hi in box):  # bounds implied by conjuncts contradict
+            return Answer(Status.UNSAT, solver=self.name)
+        refuter = _Refuter(flint.arb, names)
+        return _search(refuter, formula, box, time.monotonic() + timeout, stop)
+
+
+def _search(refuter, formula, start, deadline: float, stop) -> Answer:
+    stack, boxes = [start], 0
+    smallest = [SMALLEST * max(hi - lo, 1.0) for lo, hi in start]
+    while stack:
+        box = stack.pop()
+        boxes += 1
+        if boxes % 64 == 0 and (time.monotonic() > deadline
+                                or (stop is not None and stop.is_set())):
+            return Answer(Status.UNKNOWN, reason=f"timeout after {boxes} boxes, "
+                          f"{len(stack) + 1} left to refute")
+        if refuter.refutes(formula, box):
+            continue
+        widest = max(range(len(box)), key=lambda i: (box[i][1] - box[i][0]) / smallest[i])
+        lo, hi = box[widest]
+        middle = (lo + hi) / 2
+        if not lo < middle < hi or hi - lo < smallest[widest]:
+            return Answer(Status.UNKNOWN, reason=f"a box of width {hi - lo:.3g} is not "
+                          "refuted (the query may hold there)")
+        stack.append(box[:widest] + [(middle, hi)] + box[widest + 1:])
+        stack.append(box[:widest] + [(lo, middle)] + box[widest + 1:])
+    return Answer(Status.UNSAT, solver=ArbBackend.name)
+
+
+class _Refuter:
+    def __init__(self, arb, names):
+        self.arb = arb
+        self.index = {name: i for i, name in enumerate(names)}
+
+    def refutes(self, formula: L.Formula, box) -> bool:
+        """Whether no point of the box satisfies the formula (False: not shown)."""
+        values = [self.arb(lo).union(self.arb(hi)) for lo, hi in box]
+        return self._refutes(formula, values, {})
+
+    def _refutes(self, formula: L.Formula, values, memo) -> bool:
+        if isinstance(formula, L.BoolConst):
+            return not formula.value
+        if isinstance(formula, L.Not):
+            return self._refutes(L.negated_inward(formula.arg), values, memo)
+        if isinstance(formula, L.And):
+            return any(self._refutes(arg, values, memo) for arg in formula.args)
+        if isinstance(formula, L.Or):
+            return all(self._refutes(arg, values, memo) for arg in formula.args)
+        if isinstance(formula, L.Compare) and formula.relation in BELOW + ABOVE:
+            difference = self.enclose(E.add(formula.left, E.neg(formula.right)), values, memo)
+            if difference is None:
+                return False
+            # the closure of the comparison's set: d <= 0 (or d >= 0) cannot hold
+            return bool(difference > 0) if formula.relation in BELOW else bool(difference < 0)
+        return False
+
+    def enclose(self, expr: E.Expr, values, memo):
+        """A ball holding every value of the expression on the box, or None where
+        one is not computed (an unknown function)."""
+        key = id(expr)
+        if key not in memo:
+            memo[key] = (expr, self._enclose(expr, values, memo))
+        return memo[key][1]
+
+    def _enclose(self, expr: E.Expr, values, memo):
+        arb = self.arb
+        if isinstance(expr, E.Num):
+            return _rational(arb, expr.value)
+        if isinstance(expr, E.Pi):
+            return arb.pi()
+        if isinstance(expr, E.Var):
+            return values[self.index[expr.name]]
+        parts = [self.enclose(child, values, memo) for child in E.children(expr)]
+        if any(p is None for p in parts):
+            return None
+        if isinstance(expr, E.Neg):
+            return -parts[0]
+        if isinstance(expr, E.Add):
+            return sum(parts[1:], parts[0])
+        if isinstance(expr, E.Mul):
+            return _product(expr.factors, parts)
+        if isinstance(expr, E.Div):
+            return parts[0] / parts[1]
+        if isinstance(expr, E.Pow):
+            return _power(arb, parts[0], expr.exponent, parts[1])
+        if isinstance(expr, E.Apply):
+            if expr.func == "abs":
+                return _abs(arb, parts[0])
+            method = getattr(parts[0], expr.func, None)
+            return method() if method is not None else None
+        return None
+
+
+def _rational(arb, value: Fraction):
+    return arb(value.numerator) / arb(value.denominator)
+
+
+def _product(factors, parts):
+    """x*x as a square (ball multiplication does not know both factors are one)."""
+    result, seen = None, {}
+    for factor, part in zip(factors, parts):
+        seen.setdefault(factor, [part, 0])[1] += 1
+    for part, count in seen.values():
+        term = _integer_power(part, count)
+        result = term if result is None else result * term
+    return result
+
+
+def _power(arb, base, exponent: E.Expr, exponent_value):
+    if isinstance(exponent, E.Num) and exponent.value.denominator == 1:
+        n = int(exponent.value)
+        return _integer_power(base, n) if n >= 0 else 1 / _integer_power(base, -n)
+    if isinstance(exponent, E.Num) and exponent.value == Fraction(1, 2):
+        return base.sqrt()
+    return (exponent_value * base.log()).exp()
+
+
+def _integer_power(base, n: int):
+    """base^n; for even n the ball of [min |x|^n, max |x|^n] (a ball round 0 would
+    otherwise give a negative lower end)."""
+    if n % 2 or n == 0:
+        return base ** n
+    low, high = base.abs_lower(), base.abs_upper()
+    return (low ** n).union(high ** n)
+
+
+def _abs(arb, value):
+    return value.abs_lower().union(value.abs_upper())
+
+
+def starting_box(formula: L.Formula, names) -> list[tuple[float, float]] | None:
+    """Float bounds (rounded outwards) for each variable from the query's top-level
+    conjuncts, or None where some variable gets none."""
+    low = {name: -math.inf for name in names}
+    high = {name: math.inf for name in names}
+    for atom in _conjuncts(formula):
+        for name, lower, upper in _bounds(atom, names):
+            low[name] = max(low[name], lower)
+            high[name] = min(high[name], upper)
+    if not all(math.isfinite(low[n]) and math.isfinite(high[n]) for n in names):
+        return None
+    return [(low[n], high[n]) for n in names]
+
+
+def _conjuncts(formula: L.Formula) -> list[L.Formula]:
+    if isinstance(formula, L.And):
+        return [atom for arg in formula.args for atom in _conjuncts(arg)]
+    if isinstance(formula, L.Not) and isinstance(formula.arg, L.Compare):
+        return [L.negated_inward(formula)]
+    return [formula]
+
+
+def _bounds(atom: L.Formula, names):
+    """(variable, lower, upper) that the comparison implies: from `x <= c`, `c <= x`, and
+    an axis-parallel ellipsoid `sum a_i (x_i - c_i)^2 <= r`."""
+    if not isinstance(atom, L.Compare) or atom.relation not in BELOW + ABOVE:
+        return []
+    small, large = (atom.left, atom.right) if atom.relation in BELOW \
+        else (atom.right, atom.left)
+    try:
+        polynomial = P.polynomial(E.add(small, E.neg(large)), names)  # <= 0
+    except ValueError:
+        return []
+    return _ellipsoid_bounds(polynomial, names)
+
+
+def _ellipsoid_bounds(polynomial: dict, names):
+    """For p(x) <= 0 with p = sum (a_i x_i^2 + b_i x_i) + k, every a_i >= 0 (no products
+    of two variables): |x_i + b_i / 2a_i| <= sqrt(R / a_i), R = sum b_i^2 / 4a_i - k,
+    where a_i > 0; x_i <= -k / b_i (or >=) where p is linear in x_i alone."""
+    n = len(names)
+    square, linear, constant = {}, {}, Fraction(0)
+    for monomial, coefficient in polynomial.items():
+        degree = sum(monomial)
+        if degree == 0:
+            constant = Fraction(coefficient)
+        elif degree == 1 or (degree == 2 and max(monomial) == 2):
+            i = max(range(n), key=lambda j: monomial[j])
+            (square if degree == 2 else linear)[i] = Fraction(coefficient)
+        else:
+            return []
+    if any(a <= 0 for a in square.values()):
+        return []
+    if not square:
+        if len(linear) != 1:
+            return []
+        (i, b), = linear.items()
+        edge = -constant / b
+        return [(names[i], -math.inf, _up(edge))] if b > 0 else [(names[i], _down(edge), math.inf)]
+    if set(linear) - set(square):
+        return []
+    radius = sum(linear.get(i, 0) ** 2 / (4 * a) for i, a in square.items()) - constant
+    if radius < 0:
+        return []
+    found = []
+    for i, a in square.items():
+        centre = -Fraction(linear.get(i, 0)) / (2 * a)
+        reach = Fraction(_sqrt_up(radius / a))
+        found.append((names[i], _down(centre - reach), _up(centre + reach)))
+    return found
+
+
+def _sqrt_up(value: Fraction) -> float:
+    root = math.sqrt(_up(value))
+    while Fraction(root) ** 2 < value:
+        root = math.nextafter(root, math.inf)
+    return root
+
+
+def _up(value: Fraction) -> float:
+    near = float(value)
+    return near if Fraction(near) >= value else math.nextafter(near, math.inf)
+
+
+def _down(value: Fraction) -> float:
+    near = float(value)
+    return near if Fraction(near) <= value else math.nextafter(near, -math.inf)

@@ -1,0 +1,104 @@
+"""The Arb refutation procedure (recheck's second procedure for transcendental queries):
+UNSAT only where no point satisfies the query, its starting box rounded outwards, and
+UNKNOWN where the query does not bound its variables."""
+from fractions import Fraction
+
+from hypothesis import given, settings, strategies as st
+
+from fossil_dsl import loads
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.solvers.arb_backend import ArbBackend, starting_box
+from fossil_dsl.solvers.api import Status
+
+x, y = E.Var("x"), E.Var("y")
+
+
+def num(value) -> E.Num:
+    return E.Num(Fraction(value))
+
+
+def box(low, high, *variables):
+    return [L.Compare(op, a, b) for v in variables
+            for op, a, b in (("<=", num(low), v), ("<=", v, num(high)))]
+
+
+def check(*atoms, seconds: float = 10.0):
+    return ArbBackend().check(L.conjunction(*atoms), ["x", "y"], seconds).status
+
+
+def test_refutes_what_cannot_hold():
+    assert check(*box(-3, 3, x, y), L.Compare(">", E.Apply("sin", x), num("1.0001"))) \
+        is Status.UNSAT
+    disc = L.Compare("<=", E.add(E.mul(x, x), E.mul(y, y)), num(1))
+    assert check(disc, L.Compare(">=", x, num("1.001"))) is Status.UNSAT
+    # exp(x) >= 1 + x everywhere: exp(x) < 1 + x - 0.01 nowhere in the box
+    gap = L.Compare("<", E.Apply("exp", x), E.add(num(1), x, num("-0.01")))
+    assert check(*box(-2, 2, x, y), gap) is Status.UNSAT
+
+
+def test_a_point_on_the_edge_of_the_ball_is_not_refuted():
+    # (1, 0) satisfies both: the ball's bound on x must not be rounded inwards
+    disc = L.Compare("<=", E.add(E.mul(x, x), E.mul(y, y)), num(1))
+    assert check(disc, L.Compare(">=", x, num(1)), seconds=2.0) is not Status.UNSAT
+    low, high = starting_box(L.conjunction(disc), ["x", "y"])[0]
+    assert low <= -1 and high >= 1
+
+
+def test_an_unbounded_variable_is_unknown():
+    assert check(L.Compare(">", E.Apply("sin", x), num(2)),
+                 *box(-1, 1, y)) is Status.UNKNOWN
+
+
+def test_shifted_ellipsoids_bound_their_variables():
+    # 2 (x - 1)^2 + (y + 3)^2 <= 8: x in [-1, 3], y in [-3 - 2 sqrt 2, -3 + 2 sqrt 2]
+    shape = E.add(E.mul(num(2), E.Pow(E.add(x, num(-1)), num(2))),
+                  E.Pow(E.add(y, num(3)), num(2)))
+    (xl, xh), (yl, yh) = starting_box(L.Compare("<=", shape, num(8)), ["x", "y"])
+    assert xl <= -1 <= xl + 1e-9 and xh - 1e-9 <= 3 <= xh
+    assert yl <= -3 - 8 ** 0.5 and yh >= -3 + 8 ** 0.5
+
+
+POINT = st.fractions(min_value=-2, max_value=2, max_denominator=64)
+FUNCTIONS = st.sampled_from(["sin", "cos", "exp", "tanh", "atan"])
+
+
+@settings(max_examples=60, deadline=None)
+@given(POINT, POINT, FUNCTIONS, st.integers(1, 3), st.sampled_from(["<", "<=", ">", ">="]))
+def test_a_query_that_holds_at_a_point_is_never_refuted(a, b, func, power, relation):
+    # the comparison is made true at (a, b) by putting its right side at the value there
+    # (the exact value for the non-strict relations; just beyond it for the strict ones)
+    left = E.add(E.Apply(func, E.mul(x, y)), E.Pow(E.add(x, E.neg(y)), num(power)))
+    at_point = E.Num(Fraction(a)), E.Num(Fraction(b))
+    from fossil_dsl.ir import traversal
+    from fossil_dsl.ir.enclosure import bounds
+    low, high = bounds(traversal.substitute(left, {"x": at_point[0], "y": at_point[1]}))
+    right = {"<": high + Fraction(1, 10**6), "<=": high,
+             ">": low - Fraction(1, 10**6), ">=": low}[relation]
+    query = [*box(-2, 2, x, y), L.Compare(relation, left, num(right)),
+             L.Compare("<=", E.add(E.mul(x, x), E.mul(y, y)),
+                       num(Fraction(a) ** 2 + Fraction(b) ** 2))]
+    assert check(*query, seconds=1.0) is not Status.UNSAT
+
+
+def test_recheck_uses_it_for_a_query_the_interval_verifier_proved(tmp_path):
+    import fossil_dsl
+    from fossil_dsl.outputs.recheck import recheck
+    spec = loads("""\
+state x, y
+dynamics continuous {
+    x' = -x + 0.2*sin(y)
+    y' = -y + 0.1*x*cos(x)
+}
+domain ball([0, 0], 2)
+set init = ball([0, 0], 0.5)
+set unsafe = ~ball([0, 0], 1.8)
+prove from init: always not unsafe
+""")
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=60)
+    assert result.certified, result.reason
+    result.save(tmp_path)
+    checks = recheck(tmp_path, timeout=30)
+    assert all(c.reproved for c in checks), [c for c in checks if not c.reproved]
+    by_interval = [c for c in checks if c.proved_by == "interval"]
+    assert by_interval and all(c.solver == "arb" for c in by_interval)
