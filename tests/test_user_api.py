@@ -389,3 +389,27 @@ def test_a_bespoke_domain_without_a_box_is_refused():
     with pytest.raises(fossil_dsl.BuildError, match="needs a `box`"):
         built(domain=Anywhere())
 
+
+
+# the decrease of a rational V vanishes at the origin: the interval procedure cannot
+# refute the boxes round it and answers delta-SAT there, which is not a counterexample
+RATIONAL = """\
+state x0, x1
+dynamics continuous {
+    x0' = -x0 + x1/(x0^2 + 1)
+    x1' = -x1
+}
+domain ball([0, 0], 1)
+prove stable
+"""
+
+
+def test_recheck_never_reports_a_delta_sat_box_as_a_failure(tmp_path):
+    from fossil_dsl.outputs import recheck
+    result = fossil_dsl.synthesise(fossil_dsl.loads(RATIONAL), seed=0, timeout=60)
+    assert result.certified, result.reason
+    result.save(tmp_path)
+    checks = recheck.recheck(tmp_path, timeout=20)
+    assert all(c.reproved for c in checks), [c for c in checks if not c.reproved]
+    by_interval = recheck.recheck(tmp_path, timeout=5, solver="interval")
+    assert all(c.status in ("unsat", "unknown") for c in by_interval), by_interval

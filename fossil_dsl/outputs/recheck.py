@@ -42,6 +42,9 @@ POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "dreal")
 # transcendental query the interval verifier proved: CVC5 left four BarrierBench flow
 # conditions with sin and cos UNKNOWN at 60 s, which Arb refutes in 0.7 to 9 s.
 TRANSCENDENTAL_ORDER = ("dreal", "interval", "arb", "cvc5")
+# division and abs: decided by the SMT solvers (a delta-decision procedure cannot refute
+# the boxes round the origin where a rational V's decrease vanishes)
+ARITHMETIC_ORDER = ("cvc5", "z3", "interval", "arb", "dreal")
 RECHECK_ONLY = (SUM_OF_SQUARES, "arb")  # procedures that are not verifiers of a run
 
 
@@ -190,9 +193,13 @@ def _decide(name: str, formula: L.Formula, variables, used: str, timeout: float,
     for solver in solvers:
         started = time.monotonic()
         answer = _backend(solver).check(formula, variables, timeout / len(solvers))
-        check = Recheck(name, used, solver, answer.status.value, _reason(answer),
+        status = answer.status.value
+        if answer.status is Status.SAT and answer.approximate:
+            # delta-SAT: a box too narrow to refute, not a counterexample
+            status = "unknown"
+        check = Recheck(name, used, solver, status, _reason(answer),
                         time.monotonic() - started)
-        if answer.status is not Status.UNKNOWN:
+        if status != "unknown":
             break
     return check
 
@@ -227,9 +234,10 @@ def _backend(name: str):
 
 def other_solvers(used: str, formula: L.Formula) -> list[str]:
     """The installed solvers other than `used` suited to the formula, best first."""
-    polynomial = all(traversal.is_polynomial(side) for c in L.comparisons(formula)
-                     for side in (c.left, c.right))
-    order = POLYNOMIAL_ORDER if polynomial else TRANSCENDENTAL_ORDER
+    sides = [side for c in L.comparisons(formula) for side in (c.left, c.right)]
+    order = POLYNOMIAL_ORDER if all(map(traversal.is_polynomial, sides)) \
+        else ARITHMETIC_ORDER if all(map(traversal.is_arithmetic, sides)) \
+        else TRANSCENDENTAL_ORDER
     if not L.free_vars(formula):  # a fact about numbers: no box to search
         order = ("z3", "cvc5")
     return [n for n in order if n != used
@@ -239,6 +247,8 @@ def other_solvers(used: str, formula: L.Formula) -> list[str]:
 def _reason(answer) -> str:
     if answer.status is Status.SAT and answer.model:
         point = ", ".join(f"{k} = {float(v):.6g}" for k, v in answer.model.items())
+        if answer.approximate:
+            return f"delta-sat: a box round {point} it could not refute (not a counterexample)"
         return f"counterexample {point}"
     return answer.reason or ""
 
