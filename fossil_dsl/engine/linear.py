@@ -35,9 +35,9 @@ MAX_CONDITION = 1e6  # a P this ill-conditioned would not survive rounding to de
 def jacobians(spec: CheckedSpec, inputs=None, state=None) -> tuple[np.ndarray, np.ndarray] | None:
     """A = df/dx and B = df/du at x = `state` (default 0) and u = `inputs` (default 0),
     or None where a derivative is not a finite number there."""
-    origin = _point(spec, inputs, state)
+    point = _point(spec, inputs, state)
     try:
-        rows = [[_value_at(derivative(f, v), origin) for v in (*spec.states, *spec.inputs)]
+        rows = [[_value_at(derivative(f, v), point) for v in (*spec.states, *spec.inputs)]
                 for f in spec.dynamics]
     except (E.ExprError, ValueError, ZeroDivisionError):
         return None
@@ -105,13 +105,13 @@ def _residual(spec: CheckedSpec, inputs, state) -> np.ndarray | None:
     return values
 
 
-def _value_at(expr: E.Expr, origin) -> float:
-    value = traversal.substitute(expr, origin)
+def _value_at(expr: E.Expr, point) -> float:
+    value = traversal.substitute(expr, point)
     if isinstance(value, E.Num):
         return float(value.value)
     low, high = enclose(value)
     if not low <= high:
-        raise ValueError("undefined at the origin")
+        raise ValueError("undefined at the point")
     return (low + high) / 2
 
 

@@ -1,7 +1,9 @@
 """Quadratic shapes for seeds: closed loops of the linearisation under several LQR
-weightings, and Lyapunov matrices P of a closed loop under which one sampled set lies
-as far inside {x^T P x <= 1} as possible relative to another (a small semidefinite
-program). Used by the safety and reach-type seeds; nothing here is trusted."""
+weightings, Lyapunov matrices P of a closed loop under which one sampled set lies as far
+inside {x^T P x <= 1} as possible relative to another (a small semidefinite program),
+and the smallest value of (x - c)^T P (x - c) on boxes, balls and their combinations
+(the floors a seed's level must stay under). Used by the safety and reach-type seeds;
+nothing here is trusted."""
 from __future__ import annotations
 
 import math
@@ -149,7 +151,7 @@ def boundary_floor(P: np.ndarray, region, centre: np.ndarray) -> float | None:
     if isinstance(region, S.Intersection):
         parts = [boundary_floor(P, side, centre) for side in (region.left, region.right)]
         return None if None in parts else min(parts)
-    bounds = _numbers(region)
+    bounds = _numbers(region) if isinstance(region, (S.Box, S.Ball)) else None
     if bounds is None:
         return None
     if isinstance(region, S.Box):
@@ -175,7 +177,7 @@ def set_floor(P: np.ndarray, region, centre: np.ndarray) -> float | None:
         return None if None in parts else min(parts)
     if isinstance(region, S.Complement):
         return boundary_floor(P, region.operand, centre)
-    bounds = _numbers(region)
+    bounds = _numbers(region) if isinstance(region, (S.Box, S.Ball)) else None
     if bounds is None:
         return None
     if isinstance(region, S.Box):
@@ -210,19 +212,12 @@ def _unnamed(region):
 
 
 def _numbers(region):
-    """A box's (low, high) or a ball's (centre, radius) as floats, or None."""
-    try:
-        if isinstance(region, S.Box):
-            return (np.array([float(_value(v)) for v in region.lower]),
-                    np.array([float(_value(v)) for v in region.upper]))
-        if isinstance(region, S.Ball):
-            return np.array([float(_value(v)) for v in region.centre]), float(_value(region.radius))
-    except (TypeError, ValueError):
+    """A box's (low, high) or a ball's (centre, radius) as floats, from its bounding box
+    (None where it has none)."""
+    box = region.bounding_box()
+    if box is None:
         return None
-    return None
-
-
-def _value(expr):
-    from fossil_dsl.ir.enclosure import enclose
-    low, high = enclose(expr)
-    return (low + high) / 2
+    low, high = (np.asarray(side, dtype=float) for side in box)
+    if isinstance(region, S.Box):
+        return low, high
+    return (low + high) / 2, float(np.min(high - low)) / 2

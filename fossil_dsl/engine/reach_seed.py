@@ -44,11 +44,11 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
         return []
     rng = np.random.default_rng(plan.options.seed)
     discrete = plan.spec.time is TimeDomain.DISCRETE
+    floor = functools.partial(boundary_floor, region=plan.spec.property.role("safe"),
+                              centre=np.zeros(len(plan.states)))
     found = []
     for A, K in lqr_gains(plan.spec, controller is not None, operating, rng):
         barrier = _barrier_part(A, discrete, samples) if "B" in networks else None
-        floor = functools.partial(boundary_floor, region=plan.spec.property.role("safe"),
-                                  centre=np.zeros(len(plan.states)))
         for ratio, P, level in separations(A, discrete, samples.get("initial"),
                                            samples.get("boundary"), floor=floor):
             if ratio < MIN_RATIO:
