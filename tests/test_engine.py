@@ -9,7 +9,8 @@ import torch
 
 import fossil_dsl
 from fossil_dsl.engine.loop import Cegis
-from fossil_dsl.plan.compile import compile_spec, loss_text, plan_text, symbolic_queries
+from fossil_dsl.plan.compile import compile_spec
+from fossil_dsl.plan.readable import loss_text, plan_text, symbolic_queries
 from fossil_dsl.kernel import not_certified
 from fossil_dsl.outputs.result import build_result, write_artefacts
 from fossil_dsl.solvers.api import Answer, Status
@@ -169,19 +170,22 @@ def test_run_writes_artefacts_with_o(tmp_path):
     assert (tmp_path / "out" / "obligations" / "condition-decrease.smt2").exists()
 
 
-@pytest.mark.parametrize("prove", ["from init: stable", "from init: safe until goal",
-                                   "from init: eventually goal"])
-def test_discrete_time_without_a_sound_certificate_is_a_clear_error(tmp_path, prove):
-    path = tmp_path / "discrete.fsl"
-    path.write_text("state x0, x1\ndynamics discrete {\n    next(x0) = 0.5*x0\n"
-                    "    next(x1) = 0.5*x1\n}\ndomain box([-1, -1], [1, 1])\n"
-                    "set init = ball([0, 0], 0.5)\nset goal = ball([0, 0], 0.1)\n"
-                    f"set safe = box([-0.9, -0.9], [0.9, 0.9])\nprove {prove}\n")
-    run = subprocess.run([str(FOSSILC), str(path)], capture_output=True, text=True, timeout=120)
-    assert run.returncode == 2, run.stdout + run.stderr
-    assert "Traceback" not in run.stderr
-    assert f"{path}:2:1: error:" in run.stderr
-    assert "in discrete time is not supported" in run.stderr
+def test_a_rule_without_discrete_time_is_refused_for_a_map_with_the_dynamics_line():
+    """Every built-in rule has a discrete version (tests/test_discrete_rules.py); a rule
+    defined in Python that does not say it is sound in discrete time is refused."""
+    from fossil_dsl.plan.certificates.roa import RegionOfAttraction
+    from fossil_dsl.plan.compile import CompileError
+
+    class ContinuousOnly(RegionOfAttraction):
+        discrete_time = False
+
+    spec = fossil_dsl.loads("state x0, x1\ndynamics discrete {\n    next(x0) = 0.5*x0\n"
+                            "    next(x1) = 0.5*x1\n}\ndomain box([-1, -1], [1, 1])\n"
+                            "set init = ball([0, 0], 0.5)\nprove from init: stable\n",
+                            "discrete.fsl")
+    with pytest.raises(CompileError, match="in discrete time is not supported") as caught:
+        compile_spec(spec, certificate=ContinuousOnly)
+    assert caught.value.span.line == 2
 
 
 def test_candidate_must_vanish_at_the_origin(tmp_path):

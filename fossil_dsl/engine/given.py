@@ -31,10 +31,12 @@ class GivenFunctions:
     def levels(self) -> dict[str, float]:
         return {level.name: float(level_value(
             self.values(level.function, level.above),
-            self.values(level.function, level.below) if level.below else None,
+            self.values(level.function, level.below),
             self.plan.options.margin)) for level in self.plan.levels}
 
-    def values(self, function: str, condition: str) -> np.ndarray:
+    def values(self, function: str, condition: str | None) -> np.ndarray | None:
+        if condition is None:
+            return None
         points = self.samples[condition]
         value = evaluate(self.candidates[function], state_env(self.plan.states, points))
         return np.broadcast_to(np.asarray(value, dtype=np.float64), (len(points),))

@@ -20,7 +20,8 @@ from fossil_dsl.engine.networks import Network, input_divisors
 from fossil_dsl.engine.sampling import box_centre, sample
 from fossil_dsl.engine.violations import ViolationSearch
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.plan.certificates.base import Condition, Level, change_of, level_of, value_of
+from fossil_dsl.plan.certificates.base import (Condition, Level, change_of, level_of,
+                                               next_value, value_of)
 from fossil_dsl.plan.compile import Plan
 
 FRESH_SEARCHES = 5  # searches of fresh samples per training round, at most
@@ -65,6 +66,7 @@ class Learner(ViolationSearch):
         self.digits = plan.options.digits  # of the last rounding
         needed = set().union(*(placeholders(c) for c in plan.conditions))
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
+        self.next_needed = any(next_value(s).name in needed for s in self.states)
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V or B (and LQR controller) as the starting point
@@ -147,6 +149,9 @@ class Learner(ViolationSearch):
         """Each named function's value and change (derivative along the flow, or
         one-step difference) at the points, which must require gradients."""
         result, field = {}, None
+        if self.next_needed:  # f(x) itself, for claims such as f(x) ∈ S
+            field = self.field(points)
+            result.update({next_value(s).name: f for s, f in zip(self.states, field)})
         for name in names:
             value = self.function(name, points)
             result[value_of(name).name] = value
@@ -181,6 +186,9 @@ class Learner(ViolationSearch):
         is a tensor that keeps its gradient: a loss that pushes V below it then also
         pushes that smallest value up, instead of dragging V and the level down
         together for ever."""
+        if level.above is None:  # just over the largest value `below`, with its gradient
+            below = self.function(level.function, self.samples[level.below])
+            return level_value(None, below, self.plan.options.margin)
         above = self.function(level.function, self.samples[level.above])
         below = None
         if level.below is not None:

@@ -27,7 +27,8 @@ LEVEL_SLACK = 0.02  # of the spread of the values `above`, kept below their samp
 
 def level_value(above, below, margin: float):
     """A level under the values `above` and over the values `below` (halfway), or,
-    without `below`, just under `above` by twice the margin or a fiftieth of their
+    without `below`, just under `above` (without `above`, just over `below`) by twice
+    the margin or a fiftieth of their
     spread, whichever is more (then it is an array that keeps the gradient of the
     smallest value, when learning). The spread counts because samples miss the true
     minimum by more on larger sets and steeper functions: 4 states, V up to 300 on a
@@ -37,6 +38,11 @@ def level_value(above, below, margin: float):
             return 0.0
         spread = _number(above.max()) - _number(above.min())
         return above.min() - max(2 * margin, LEVEL_SLACK * spread)
+    if above is None:  # the mirror image: just over the values `below`
+        if not len(below):
+            return 0.0
+        spread = _number(below.max()) - _number(below.min())
+        return below.max() + max(2 * margin, LEVEL_SLACK * spread)
     low = _number(above.min()) if len(above) else None
     return between(_number(below.max()) if len(below) else None, low)
 

@@ -12,7 +12,7 @@ from fractions import Fraction
 from typing import Callable
 
 from fossil_dsl.engine.given import GivenFunctions, verifier_only
-from fossil_dsl.plan.certificates.base import change_of, level_of, value_of
+from fossil_dsl.plan.certificates.base import change_of, level_of, next_value, value_of
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
@@ -66,9 +66,11 @@ class ExactCandidate:
     controller: dict[str, E.Expr]  # input name -> k_i(x)
     levels: dict[str, Fraction]
     digits: int  # decimals kept when the weights were rounded
+    next_state: dict[str, E.Expr] = field(default_factory=dict)  # discrete: state -> f(x)
 
     def mapping(self) -> dict[str, E.Expr]:
-        found = {value_of(n).name: f for n, f in self.formulas.items()}
+        found = {next_value(s).name: f for s, f in self.next_state.items()}
+        found.update({value_of(n).name: f for n, f in self.formulas.items()})
         found.update({change_of(n).name: c for n, c in self.changes.items()})
         found.update({level_of(n).name: E.Num(v) for n, v in self.levels.items()})
         return found
@@ -247,7 +249,9 @@ class Cegis:
         closed_loop = tuple(traversal.substitute(f, controller) for f in self.plan.spec.dynamics)
         changes = {name: self.change(formula, closed_loop) for name, formula in formulas.items()}
         levels = {name: rational(value, digits) for name, value in learner.levels().items()}
-        return ExactCandidate(formulas, changes, controller, levels, digits)
+        next_state = dict(zip(self.states, closed_loop)) \
+            if self.plan.spec.time is TimeDomain.DISCRETE else {}
+        return ExactCandidate(formulas, changes, controller, levels, digits, next_state)
 
     def change(self, formula: E.Expr, dynamics) -> E.Expr:
         if self.plan.spec.time is TimeDomain.DISCRETE:

@@ -2,6 +2,8 @@
 its guard holds, and whether they meet it."""
 from __future__ import annotations
 
+import functools
+
 import torch
 
 from fossil_dsl.engine.evaluate import evaluate, holds
@@ -17,11 +19,21 @@ def placeholders(condition: Condition) -> frozenset[str]:
 
 
 def violation_of(claim: L.Formula, env) -> torch.Tensor:
-    """How far the claim is from holding (positive: violated)."""
-    if not isinstance(claim, L.Compare):
-        raise TypeError(f"a claim must be one comparison, not {claim}")
-    difference = evaluate(claim.left, env) - evaluate(claim.right, env)
-    return difference if claim.relation in ("<", "<=") else -difference
+    """How far the claim is from holding (positive: violated). A comparison's is the
+    difference of its sides; a conjunction's the largest of its parts', a disjunction's
+    the smallest, a negation's the opposite (a claim such as f(x) ∈ S, with S a box
+    or a difference of sets, is learned like any other)."""
+    if isinstance(claim, L.Compare):
+        difference = evaluate(claim.left, env) - evaluate(claim.right, env)
+        return difference if claim.relation in ("<", "<=") else -difference
+    if isinstance(claim, L.Not):
+        return -violation_of(claim.arg, env)
+    if isinstance(claim, (L.And, L.Or)):
+        parts = [torch.as_tensor(violation_of(a, env), dtype=torch.float64)
+                 for a in claim.args]
+        combine = torch.maximum if isinstance(claim, L.And) else torch.minimum
+        return functools.reduce(combine, parts)
+    raise TypeError(f"a claim cannot be the constant {claim}")
 
 
 def guard_mask(guard: L.Formula, env, batch: int, band: float) -> torch.Tensor:

@@ -21,9 +21,12 @@ import functools
 import numpy as np
 
 from fossil_dsl.engine.evaluate import holds, state_env
-from fossil_dsl.engine.linear import (holds_a_quadratic, is_linear, operating_point,
-                                      quadratic_values, set_linear, set_quadratic)
+from fossil_dsl.engine.linear import (as_array, holds_a_quadratic, is_linear,
+                                      operating_point, quadratic_values, set_linear,
+                                      set_quadratic)
+from fossil_dsl.engine.sampling import sample
 from fossil_dsl.engine.quadratic_shapes import boundary_floor, lqr_gains, separations
+from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.rwa import GAMMA
 
@@ -46,11 +49,14 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
     discrete = plan.spec.time is TimeDomain.DISCRETE
     floor = functools.partial(boundary_floor, region=plan.spec.property.role("safe"),
                               centre=np.zeros(len(plan.states)))
+    boundary = samples.get("boundary")
+    if boundary is None:  # discrete time has no condition on ∂S; the ellipsoid must fit
+        boundary = _boundary_samples(plan, rng)
     found = []
     for A, K in lqr_gains(plan.spec, controller is not None, operating, rng):
         barrier = _barrier_part(A, discrete, samples) if "B" in networks else None
-        for ratio, P, level in separations(A, discrete, samples.get("initial"),
-                                           samples.get("boundary"), floor=floor):
+        for ratio, P, level in separations(A, discrete, samples.get("initial"), boundary,
+                                           floor=floor):
             if ratio < MIN_RATIO:
                 continue
             scale = _scale(P, A, discrete, level, samples.get("decrease"))
@@ -62,6 +68,15 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
     found.sort(key=lambda fit: fit[0], reverse=True)
     return [(True, _setter(networks, controller, v_part, b_part, K, operating))
             for _, v_part, b_part, K in found]
+
+
+def _boundary_samples(plan, rng: np.random.Generator, count: int = 1000) -> np.ndarray:
+    """Points of the boundary of the safe set (as the plan would sample it)."""
+    import torch
+    generator = torch.Generator().manual_seed(int(rng.integers(2 ** 31)))
+    points = sample(Boundary(plan.spec.property.role("safe")), plan.states, count, generator,
+                    plan.spec.domain.bounding_box())
+    return as_array(points)
 
 
 def _setter(networks, controller, v_part, b_part, K, operating):

@@ -23,7 +23,8 @@ from rich.progress import Progress, TextColumn
 from fossil_dsl.diagnostics import error
 from fossil_dsl.frontends import arguments
 from fossil_dsl.frontends.checking import CheckResult, check_file, check_text
-from fossil_dsl.plan.compile import CompileError, compile_spec, loss_text, plan_text, symbolic_queries
+from fossil_dsl.plan.compile import CompileError, compile_spec
+from fossil_dsl.plan.readable import loss_text, plan_text, symbolic_queries
 from fossil_dsl.solvers.registry import BackendUnavailable
 from fossil_dsl.version import __version__
 

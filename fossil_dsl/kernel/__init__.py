@@ -1,7 +1,8 @@
 """The proof kernel: the only part of fossil_dsl that can say CERTIFIED.
 
 It takes the checked spec and the final exact functions (a `Claim`), derives every
-obligation the guarantee rests on (`obligations.py`, `rules.py`, `definedness.py`),
+obligation the guarantee rests on (`obligations.py`, `rules.py`, `step_rules.py` for
+difference equations, `definedness.py`),
 discharges each with a sound procedure (`prove.py`) and returns the verdict
 (`verdict.py`). It imports the IR and the solvers only: no torch, no learner.
 """

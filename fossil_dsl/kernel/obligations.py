@@ -137,6 +137,11 @@ class Facts:
         self.defined(name, region, _expressions(failure))
         self.obligations.append(Obligation(name, text, L.conjunction(region, failure)))
 
+    def lands_in(self, name: str, text: str, region: L.Formula, target: S.SetExpr) -> None:
+        """Every x in `region` is mapped into `target` by one step of the closed loop."""
+        image = L.substitute(self.member(target), dict(zip(self.states, self.field)))
+        self.never(name, text, region, L.negation(image))
+
     def defined(self, name: str, region: L.Formula, expressions) -> None:
         undefined = undefined_where(expressions)
         if undefined is not None:

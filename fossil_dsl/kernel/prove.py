@@ -26,7 +26,6 @@ from enum import Enum
 from fractions import Fraction
 from typing import Sequence
 
-from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel.obligations import Obligation

@@ -133,16 +133,21 @@ def region_of_attraction(facts: Facts) -> None:
     domain, initial = facts.spec.domain, facts.role("initial")
     facts.inside("relation:initial in domain", "I lies in D", facts.member(initial),
                  facts.member(domain))
-    facts.holds("condition:boundary", "V(x) > β on the boundary of D",
-                facts.boundary(domain), compare(">", V, beta))
+    if facts.discrete:  # a step can jump over ∂D: it must land in D (step_rules.py)
+        facts.lands_in("condition:image", "f(x) lies in D for every x in D with V(x) <= β",
+                       L.conjunction(facts.member(domain), compare("<=", V, beta)), domain)
+    else:
+        facts.holds("condition:boundary", "V(x) > β on the boundary of D",
+                    facts.boundary(domain), compare(">", V, beta))
     facts.holds("condition:initial", "V(x) <= β on I", facts.member(initial),
                 compare("<=", V, beta))
+    # on the closure: the limit points of a trajectory in Ω lie there
     omega = L.conjunction(facts.closure(domain), compare("<=", V, beta))
     lyapunov_conditions(facts, omega, "Ω = {x in D : V(x) <= β}")
     facts.obligations.append(Obligation("level:beta", "β > 0", compare("<=", beta)))
     if facts.r > 0:
         facts.holds("ball:sublevel", f"V(x) < β on the excluded ball |x| <= {facts.r}, "
-                    "so no trajectory leaves Ω through it", facts.ball(facts.r),
+                    "so no trajectory leaves Ω from it", facts.ball(facts.r),
                     compare("<", V, beta))
 
 
@@ -196,10 +201,9 @@ def safety_on_the_boundary(facts: Facts) -> None:
     how="(the set {B <= 0} is mapped into itself)",
     exit="every x in D with B(x) <= 0 is mapped into D, so no step leaves D"))
 def safety_steps_stay_in_domain(facts: Facts) -> None:
-    domain = facts.member(facts.spec.domain)
-    image = L.substitute(domain, dict(zip(facts.states, facts.field)))
-    facts.never("strong:image", "f(x) lies in D for every x in D with B(x) <= 0",
-                L.conjunction(domain, compare("<=", facts.value("B"))), L.negation(image))
+    domain = facts.spec.domain
+    facts.lands_in("strong:image", "f(x) lies in D for every x in D with B(x) <= 0",
+                   L.conjunction(facts.member(domain), compare("<=", facts.value("B"))), domain)
 
 
 SWA_GUARANTEE = ROA_GUARANTEE + ("; and those trajectories never enter U: B <= 0 on I, "
@@ -213,6 +217,11 @@ strengthening("stable while avoid", CONTINUOUS, name="no ball left out",
 @rule("stable while avoid", guarantee=SWA_GUARANTEE)
 def stable_while_avoid(facts: Facts) -> None:
     region_of_attraction(facts)
+    avoiding(facts)
+
+
+def avoiding(facts: Facts) -> None:
+    """The barrier of stable while avoid: I and U disjoint, B's conditions for I and U."""
     initial, unsafe = facts.member(facts.role("initial")), facts.member(facts.role("unsafe"))
     facts.disjoint("relation:initial and unsafe", "I and U are disjoint", initial, unsafe)
     barrier_conditions(facts, "B", initial, unsafe, "I", "U", prefix="barrier_")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-from fossil_dsl.kernel import rules  # noqa: F401  (registers the rules)
+from fossil_dsl.kernel import rules, step_rules  # noqa: F401  (registers the rules)
 from fossil_dsl.kernel.obligations import (Claim, NoRule, Obligation, derive, derive_facts,
                                            derive_strengthenings)
 from fossil_dsl.kernel.prove import Outcome, Proof, discharge

@@ -14,7 +14,6 @@ from pathlib import Path
 import numpy as np
 
 from fossil_dsl.diagnostics import FslError
-from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
@@ -82,8 +81,11 @@ class _Portrait:
             ax.plot([], [], color=colour, label=name)
         self._draw_field(ax, pair)
         self._draw_functions(ax, grid, X, Y)
+        # a map's trajectory is its iterates: points, joined by thin lines in order
+        style = dict(marker="o", markersize=2.5, linewidth=0.4) \
+            if self.spec.time is TimeDomain.DISCRETE else dict(linewidth=0.8)
         for path in self.paths:
-            ax.plot(path[:, i], path[:, j], color="tab:gray", linewidth=0.8, alpha=0.9)
+            ax.plot(path[:, i], path[:, j], color="tab:gray", alpha=0.9, **style)
         ax.set_xlim(self.low[i], self.high[i])
         ax.set_ylim(self.low[j], self.high[j])
         ax.set_xlabel(self.states[i])

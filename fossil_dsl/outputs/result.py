@@ -2,7 +2,6 @@
 certificate.txt and the SMT-LIB 2 proof obligations (one file per condition)."""
 from __future__ import annotations
 
-import json
 import platform
 from importlib import metadata
 from dataclasses import dataclass, field
@@ -272,6 +271,7 @@ def condition_scripts(plan: Plan, outcome: CegisOutcome) -> dict[str, str]:
     for name, formula in candidate.formulas.items():
         functions[name] = formula
         functions[f"d{name}"] = candidate.changes[name]
+    functions.update({f"next_{s}": f for s, f in candidate.next_state.items()})
     change = "one-step difference C(f(x)) - C(x)" if plan.certificate.discrete else \
         "derivative along the flow, grad C . f"
     loop = [f"closed loop with the controller {u} = {k}" for u, k in candidate.controller.items()]

@@ -30,6 +30,19 @@ def change_of(function: str) -> E.Var:
     return E.Var(f"$d{function}")
 
 
+def next_value(state: str) -> E.Var:
+    """The placeholder for the closed loop's next state, coordinate `state` (discrete
+    time): f(x)_state."""
+    return E.Var(f"$next_{state}")
+
+
+def next_in(states, region: SetExpr) -> L.Formula:
+    """f(x) ∈ region, over the next-state placeholders: a discrete step can jump over a
+    set's boundary, so staying in a set is a claim about where each step lands."""
+    formula = region.contains_formula(states)
+    return L.substitute(formula, {s: next_value(s) for s in states})
+
+
 def level_of(name: str) -> E.Var:
     """The placeholder for a level (a number chosen from data at each iteration)."""
     return E.Var(f"${name}")
@@ -40,12 +53,13 @@ class Level:
     """A number in the conditions, such as the β of a sublevel set {V <= β}, chosen
     from data at each iteration: halfway between the largest value of `function` on the
     samples of condition `below` and the smallest on the samples of condition `above`,
-    or, without `below`, as close under that smallest value as the learning margin
-    allows. The verifier then decides the conditions with it."""
+    or, with only one of them, as close under that smallest value (over that largest
+    value) as the learning margin allows. The verifier then decides the conditions with
+    it."""
 
     name: str
     function: str
-    above: str
+    above: str | None
     below: str | None = None
     text: str = ""
 
@@ -68,7 +82,7 @@ class Condition:
     exclude_origin: bool = False
     scaled_margin: bool = False  # learn with a margin growing as |x|^2 (near 0)
     weight: float = 1.0  # of this condition's loss term
-    # the learner may also meet it by making the guard (one comparison) false there,
+    # the learner may also meet it by making the guard false there,
     # e.g. by lowering V below a level where V cannot decrease
     escapable_guard: bool = False
 

@@ -9,6 +9,7 @@ from fossil_dsl.plan.certificates.rwa import DEFAULT_LAYERS, reach_conditions
 class Reach(Certificate):
     form = "reach"
     title = "reach certificate (reach-while-avoid with S = D)"
+    discrete_time = True
     keeps_equilibrium = False
 
     def functions(self):

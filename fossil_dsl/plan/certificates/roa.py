@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from fossil_dsl.plan.certificates.base import (Certificate, Condition, Level, change_of, level_of,
-                                          register, value_of)
+                                               next_in, register, value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.sets import Boundary
@@ -13,15 +13,23 @@ DEFAULT_LAYERS = (Layer("square", 8),)
 
 def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta",
                    prefix: str = "") -> tuple[Condition, ...]:
-    """With Ω = {x in D : V(x) <= β}: V > β on ∂D, V <= β on I, and V > 0, dV < 0 on
-    Ω minus the origin."""
+    """With Ω = {x in D : V(x) <= β}: V > β on ∂D (in discrete time: f(x) ∈ D for x in
+    Ω, since a step can jump over ∂D), V <= β on I, and V > 0, dV < 0 on Ω minus the
+    origin."""
     V, dV, beta = value_of(name), change_of(name), level_of(level)
     domain = certificate.spec.domain
     inside_level = L.Compare("<=", V, beta)
     change = certificate.change_word(name)
+    if certificate.discrete:
+        # met where f(x) lands in D, or by keeping the point out of Ω (V > β)
+        kept = Condition(f"{prefix}image", "f(x) ∈ D for every x in Ω", domain,
+                         next_in(certificate.spec.states, domain), guard=inside_level,
+                         escapable_guard=True)
+    else:
+        kept = Condition(f"{prefix}boundary", f"{name}(x) > β for every x on the boundary "
+                         "of D", Boundary(domain), L.Compare(">", V, beta))
     return (
-        Condition(f"{prefix}boundary", f"{name}(x) > β for every x on the boundary of D",
-                  Boundary(domain), L.Compare(">", V, beta)),
+        kept,
         Condition(f"{prefix}initial", f"{name}(x) <= β for every x in I",
                   certificate.role("initial"), inside_level),
         Condition(f"{prefix}positive", f"{name}(x) > 0 for every x ≠ 0 in Ω",
@@ -33,7 +41,11 @@ def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta
     )
 
 
-def roa_level(name: str = "V", level: str = "beta", prefix: str = "") -> Level:
+def roa_level(certificate: Certificate, name: str = "V", level: str = "beta",
+              prefix: str = "") -> Level:
+    if certificate.discrete:  # the smallest Ω that holds I: the least to map into D
+        return Level(level, name, above=None, below=f"{prefix}initial",
+                     text=f"β: just over the largest {name} on I")
     return Level(level, name, above=f"{prefix}boundary", below=f"{prefix}initial",
                  text=f"β: between the largest {name} on I and the smallest on ∂D")
 
@@ -42,6 +54,7 @@ def roa_level(name: str = "V", level: str = "beta", prefix: str = "") -> Level:
 class RegionOfAttraction(Certificate):
     form = "region of attraction"
     title = "region-of-attraction certificate (Lyapunov function and sublevel set)"
+    discrete_time = True
 
     def functions(self):
         return (self.first_function("V", DEFAULT_LAYERS, zero_at_origin=True),)
@@ -50,5 +63,5 @@ class RegionOfAttraction(Certificate):
         return roa_conditions(self)
 
     def levels(self):
-        return (roa_level(),)
+        return (roa_level(self),)
 

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from fossil_dsl.plan.certificates.base import Certificate, Condition, change_of, register, value_of
+from fossil_dsl.plan.certificates.base import (Certificate, Condition, change_of, next_in,
+                                               register, value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.sets import Boundary, Difference, SetExpr
@@ -16,24 +17,35 @@ GAMMA = Fraction(1, 100)  # the decrease rate that forces G to be reached in fin
 def reach_conditions(certificate: Certificate, safe: SetExpr, goal: SetExpr,
                      safe_words: str, goal_words: str, name: str = "V",
                      prefix: str = "") -> tuple[Condition, ...]:
-    """V <= 0 on I, V > 0 on ∂S, and dV <= -γ on S \\ G where V <= 0."""
+    """V <= 0 on I, V > 0 on ∂S, and dV <= -γ on S \\ G where V <= 0. In discrete
+    time, a step can jump over ∂S: instead of V > 0 there, every step from S \\ G
+    where V <= 0 lands in S."""
     V, dV = value_of(name), change_of(name)
     change = certificate.change_word(name)
-    return (
-        Condition(f"{prefix}initial", f"{name}(x) <= 0 for every x in I",
-                  certificate.role("initial"), L.Compare("<=", V, E.ZERO)),
-        Condition(f"{prefix}boundary", f"{name}(x) > 0 for every x on the boundary of "
-                  f"{safe_words}", Boundary(safe), L.Compare(">", V, E.ZERO)),
-        Condition(f"{prefix}decrease", f"{change} <= -{GAMMA} for every x in {safe_words} "
-                  f"outside {goal_words} with {name}(x) <= 0", Difference(safe, goal),
-                  L.Compare("<=", dV, E.Num(-GAMMA)), guard=L.Compare("<=", V, E.ZERO)),
-    )
+    initial = Condition(f"{prefix}initial", f"{name}(x) <= 0 for every x in I",
+                        certificate.role("initial"), L.Compare("<=", V, E.ZERO))
+    decrease = Condition(
+        f"{prefix}decrease", f"{change} <= -{GAMMA} for every x in {safe_words} outside "
+        f"{goal_words} with {name}(x) <= 0", Difference(safe, goal),
+        L.Compare("<=", dV, E.Num(-GAMMA)), guard=L.Compare("<=", V, E.ZERO),
+        escapable_guard=certificate.discrete)
+    if certificate.discrete:
+        # met where f(x) lands in S, or by keeping the point out of {V <= 0}
+        kept = Condition(f"{prefix}image", f"f(x) ∈ {safe_words} for every x in "
+                         f"{safe_words} outside {goal_words} with {name}(x) <= 0",
+                         Difference(safe, goal), next_in(certificate.spec.states, safe),
+                         guard=L.Compare("<=", V, E.ZERO), escapable_guard=True)
+        return initial, kept, decrease
+    boundary = Condition(f"{prefix}boundary", f"{name}(x) > 0 for every x on the boundary "
+                         f"of {safe_words}", Boundary(safe), L.Compare(">", V, E.ZERO))
+    return initial, boundary, decrease
 
 
 @register
 class ReachWhileAvoid(Certificate):
     form = "reach while avoid"
     title = "reach-while-avoid certificate"
+    discrete_time = True
     keeps_equilibrium = False
 
     def functions(self):
@@ -41,4 +53,3 @@ class ReachWhileAvoid(Certificate):
 
     def conditions(self):
         return reach_conditions(self, self.role("safe"), self.role("goal"), "S", "G")
-

@@ -11,6 +11,7 @@ from fossil_dsl.plan.certificates.roa import DEFAULT_LAYERS, roa_conditions, roa
 class StableWhileAvoid(Certificate):
     form = "stable while avoid"
     title = "stable-while-avoid certificate (region of attraction V and barrier B)"
+    discrete_time = True
 
     def functions(self):
         return (self.first_function("V", DEFAULT_LAYERS, zero_at_origin=True),
@@ -21,5 +22,5 @@ class StableWhileAvoid(Certificate):
             self, "B", self.role("initial"), self.role("unsafe"), "I", "U", prefix="barrier_")
 
     def levels(self):
-        return (roa_level(),)
+        return (roa_level(self),)
 
