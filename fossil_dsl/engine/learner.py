@@ -70,7 +70,7 @@ class Learner(ViolationSearch):
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V or B (and LQR controller) as the starting point
-        self.seeded = linear.seed(plan, self.networks, self.controller) \
+        self.seeded = linear.seed(plan, self.networks, self.controller, self.samples) \
             or self.seed_from(safety_seed.candidates(plan, self.networks, self.controller,
                                                      self.samples)) \
             or self.seed_from(reach_seed.candidates(plan, self.networks, self.controller,
