@@ -221,3 +221,32 @@ def test_without_cvc5_polynomial_obligations_are_rechecked_by_a_refutation(tmp_p
     assert all(c.reproved for c in checks), checks
     by_refutation = [c for c in checks if c.proved_by == "z3" and c.solver == SUM_OF_SQUARES]
     assert any(c.condition.startswith("condition-") for c in by_refutation), checks
+
+
+def test_ceilings_bound_the_quadratic_on_boxes_and_balls_from_above():
+    """A box's ceiling is its largest value (at a corner: a sample of the box never
+    exceeds it, and a corner attains it); a ball's is an upper bound, tight along P's
+    widest direction."""
+    import numpy as np
+    from fractions import Fraction
+    from fossil_dsl.engine.quadratic_shapes import set_ceiling
+    from fossil_dsl.ir.expr import Num
+    from fossil_dsl.ir.sets import Ball, Box
+    rng = np.random.default_rng(1)
+    factor = rng.normal(size=(4, 4))
+    P = factor @ factor.T + 0.1 * np.eye(4)
+    centre = np.array([0.1, -0.2, 0.0, 0.3])
+    low, high = np.array([-1, 0, -2, 0.5]), np.array([0.5, 1, -1, 1.5])
+    box = Box(tuple(Num(Fraction(v)) for v in low), tuple(Num(Fraction(v)) for v in high))
+    points = rng.uniform(low, high, size=(100000, 4)) - centre
+    sampled = np.einsum("bi,ij,bj->b", points, P, points).max()
+    ceiling = set_ceiling(P, box, centre)
+    assert sampled <= ceiling + 1e-9 and sampled < ceiling  # samples miss the corner
+    corners = np.array(np.meshgrid(*zip(low, high))).reshape(4, -1).T - centre
+    assert np.isclose(np.einsum("bi,ij,bj->b", corners, P, corners).max(), ceiling)
+    ball = Ball(tuple(Num(Fraction(v)) for v in (0.5, 0, 0, -0.5)), Num(Fraction(1, 2)))
+    directions = rng.normal(size=(100000, 4))
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    on_sphere = np.array([0.5, 0, 0, -0.5]) + 0.5 * directions - centre
+    assert np.einsum("bi,ij,bj->b", on_sphere, P, on_sphere).max() <= \
+        set_ceiling(P, ball, centre) + 1e-9

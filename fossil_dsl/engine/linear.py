@@ -204,18 +204,21 @@ def seed(plan, networks: dict[str, Network], controller: Network | None,
     return True
 
 
-def separation(P: np.ndarray, inside, outside, floor: float | None = None
-               ) -> tuple[float, float | None]:
+def separation(P: np.ndarray, inside, outside, floor: float | None = None,
+               ceiling: float | None = None) -> tuple[float, float | None]:
     """(how many times the largest x^T P x on the sampled `inside` goes into the
     smallest on the sampled `outside` (or `floor`, where lower: a bound worked out for
-    the outside set's shape), infinite where the first is 0, and a level c between
-    them), or (0, None) where no level separates them."""
+    the outside set's shape; `ceiling` likewise bounds the inside set's from above),
+    infinite where the first is 0, and a level c between them), or (0, None) where no
+    level separates them."""
     if inside is None or outside is None or not len(inside) or not len(outside):
         return 0.0, None
     high = float(quadratic_values(P, inside).max())
     low = float(quadratic_values(P, outside).min())
     if floor is not None:
         low = min(low, floor)
+    if ceiling is not None:
+        high = max(high, ceiling)
     if not 0 <= high < low:
         return 0.0, None
     return (low / high if high > 0 else math.inf), high + LEVEL_POSITION * (low - high)

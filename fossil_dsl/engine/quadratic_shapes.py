@@ -6,6 +6,7 @@ and the smallest value of (x - c)^T P (x - c) on boxes, balls and their combinat
 nothing here is trusted."""
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -21,6 +22,7 @@ SDP_SAMPLES = 300  # of each sampled set, at most, in the separating program
 LMI_MARGIN = 1e-3  # the program's decrease: A^T P + P A <= -this I (P's scale: 1 on I)
 MAX_TRACE = 1e4  # keeps the program bounded where I is thin
 WEIGHT_SPREAD = 1.0  # LQR weights drawn as 10^u, u uniform in [-spread, spread]
+MAX_CORNER_STATES = 12  # a box's largest value is found over its 2^n corners up to this n
 
 
 def lqr_gains(spec, controlled: bool, operating, rng, state=None):
@@ -36,15 +38,18 @@ def lqr_gains(spec, controlled: bool, operating, rng, state=None):
             yield found
 
 
-def separations(A: np.ndarray, discrete: bool, inside, outside, shapes=None, floor=None):
+def separations(A: np.ndarray, discrete: bool, inside, outside, shapes=None, floor=None,
+                ceiling=None):
     """(ratio, P, level) of the Lyapunov matrix for Q = I and of the one that separates
     the sampled sets best (or of the `shapes` given), where they separate them; with a
     `floor` (P -> a lower bound of x^T P x on the outside set, or None), the samples'
-    smallest value is lowered to it."""
+    smallest value is lowered to it, and with a `ceiling` (an upper bound on the inside
+    set) their largest is raised to it."""
     for shape in shapes or SHAPES:
         P = shape(A, discrete, inside, outside)
         if P is not None:
-            ratio, level = separation(P, inside, outside, floor(P) if floor else None)
+            ratio, level = separation(P, inside, outside, floor(P) if floor else None,
+                                      ceiling(P) if ceiling else None)
             if level is not None:
                 yield ratio, P, level
 
@@ -187,6 +192,33 @@ def set_floor(P: np.ndarray, region, centre: np.ndarray) -> float | None:
         gap = np.linalg.norm(centre - middle) - radius
         return float(np.linalg.eigvalsh(P)[0] * gap ** 2) if gap > 0 else 0.0
     return None
+
+
+def set_ceiling(P: np.ndarray, region, centre: np.ndarray) -> float | None:
+    """An upper bound of (x - c)^T P (x - c) on a box (its largest value, at a corner),
+    a ball, their unions and intersections; else None. Samples of a box in 4 or more
+    dimensions miss its corners, where a level chosen on them alone can leave part of
+    the initial set outside the seed's sublevel set."""
+    region = _unnamed(region)
+    if isinstance(region, (S.Union, S.Intersection)):
+        parts = [set_ceiling(P, side, centre) for side in (region.left, region.right)]
+        if isinstance(region, S.Union):
+            return None if None in parts else max(parts)
+        known = [p for p in parts if p is not None]  # each side holds the intersection
+        return min(known) if known else None
+    bounds = _numbers(region) if isinstance(region, (S.Box, S.Ball)) else None
+    if bounds is None:
+        return None
+    if isinstance(region, S.Box):
+        low, high = bounds
+        if len(low) > MAX_CORNER_STATES:
+            return None
+        corners = np.array(list(itertools.product(*zip(low, high)))) - centre
+        return float(np.einsum("bi,ij,bj->b", corners, P, corners).max())
+    middle, radius = bounds
+    offset = middle - centre
+    reach = math.sqrt(offset @ P @ offset) + radius * math.sqrt(np.linalg.eigvalsh(P)[-1])
+    return float(reach ** 2)
 
 
 def _box_minimum(P, centre, low, high, steps: int = 500) -> float:

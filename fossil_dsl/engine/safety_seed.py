@@ -23,7 +23,7 @@ import numpy as np
 from fossil_dsl.engine.linear import (as_array, equilibrium, holds_a_quadratic, is_linear,
                                       operating_point, set_linear, set_quadratic)
 from fossil_dsl.engine.quadratic_shapes import (SHAPES, floor_outside, lqr_gains, separations,
-                                               set_floor)
+                                               set_ceiling, set_floor)
 from fossil_dsl.engine.sampling import sample
 from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
@@ -52,14 +52,16 @@ def candidates(plan, networks: dict, controller, samples: dict):
     discrete = plan.spec.time is TimeDomain.DISCRETE
     loops = sorted(_closed_loops(plan, network, controller, inside), key=lambda loop: loop[0])
     domain, unsafe_set = plan.spec.domain, plan.spec.property.role("unsafe")
+    initial_set = plan.spec.property.role("initial")
     passes = ((fenced, domain, True), (unsafe, None, False)) if boundary is not None \
         else ((unsafe, None, True),)
     for outside, fence, preferred in passes:
         for shape in SHAPES:  # the plain Lyapunov matrix's surer decrease first
             for weighting, centre, operating, A, K in loops:
                 floor = functools.partial(_floor, fence=fence, unsafe=unsafe_set, centre=centre)
+                ceiling = functools.partial(set_ceiling, region=initial_set, centre=centre)
                 for _, P, level in separations(A, discrete, inside - centre,
-                                               outside - centre, (shape,), floor):
+                                               outside - centre, (shape,), floor, ceiling):
                     scale = _scale(P, A, discrete, level, plan.options.margin)
                     yield preferred, _setter(network, controller, scale * P, scale * level,
                                              centre, K, operating)
