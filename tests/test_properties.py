@@ -340,6 +340,24 @@ def test_learn_only_counts_a_condition_it_violates():
     assert 0 < fails <= total
 
 
+def test_learn_only_judges_an_escapable_guard_where_it_holds(monkeypatch):
+    """A fresh sample just outside {B <= 0} (in the band trained on, where training lets
+    it escape) is not a violation of "B(f(x)) <= 0 where B(x) <= 0"; one inside is."""
+    from fossil_dsl.engine import learner as learning
+    from fossil_dsl.engine.linear import set_quadratic
+    spec = spec_text("state x0, x1\ndynamics discrete {\n    next(x0) = 1.5*x0\n"
+                     "    next(x1) = 1.5*x1\n}\ndomain box([-2, -2], [2, 2])\n"
+                     "set init = box([-0.1, -0.1], [0.1, 0.1])\n"
+                     "set unsafe = box([1.8, -2], [2, 2])\nprove from init: always not unsafe\n")
+    plan = compile_spec(spec, learn_only=True)
+    learner = learning.Learner(plan, torch.Generator().manual_seed(0))
+    set_quadratic(learner.networks["B"], np.eye(2), 1.0)  # B = |x|^2 - 1
+    points = torch.tensor([[1.01, 0.0], [0.9, 0.0]], dtype=torch.float64)
+    monkeypatch.setattr(learning, "sample", lambda *args, **kwargs: points)
+    # both steps land where B > 0; only the second starts where B <= 0
+    assert learner.violation_rates(torch.Generator())["invariance"] == (1, 1)
+
+
 # ---- compile --explain ------------------------------------------------------------------
 @pytest.mark.parametrize("name", AUTONOMOUS + ["stability_continuous", "safety_continuous"])
 def test_compile_explain_names_certificate_conditions_and_guarantee(name):

@@ -302,8 +302,8 @@ class Learner(ViolationSearch):
     # ---- learn-only ----
     def violation_rates(self, generator: torch.Generator) -> dict[str, tuple[int, int]]:
         """For each condition: how many fresh samples (not trained on) violate it, of how
-        many where its guard holds (within the band used in training, since a guard
-        such as B(x) = 0 holds exactly on no sample)."""
+        many where its guard holds (as `loss.is_met` judges: exactly, or, for a guard
+        such as B(x) = 0 that holds exactly on no sample, within the band trained on)."""
         levels = self.levels()
         rates = {}
         for condition in self.plan.conditions:
@@ -312,7 +312,9 @@ class Learner(ViolationSearch):
             if condition.exclude_origin:
                 points = points[points.norm(dim=1) > 1e-9]
             env = self.detached_environment(condition, points, levels)
-            considered = guard_mask(condition.guard, env, len(points), GUARD_BAND)
+            considered = guard_mask(condition.guard, env, len(points), 0.0)
+            if not considered.any():
+                considered = guard_mask(condition.guard, env, len(points), GUARD_BAND)
             fails = ~holds(condition.claim, env, len(points)) & considered
             rates[condition.name] = (int(fails.sum()), int(considered.sum()))
         return rates
