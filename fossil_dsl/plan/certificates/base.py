@@ -169,6 +169,14 @@ class Certificate:
     def change_word(self, function: str) -> str:
         return f"{function}(f(x)) - {function}(x)" if self.discrete else f"d{function}/dt"
 
+    def lands_in(self, name: str, text: str, region: SetExpr, target: SetExpr,
+                 guard: L.Formula) -> Condition:
+        """Discrete time: every step from `region` where `guard` holds lands in `target`;
+        the learner may also meet it at a point by making the guard false there (by
+        keeping the point out of the sublevel set the guard names)."""
+        return Condition(name, text, region, next_in(self.spec.states, target), guard=guard,
+                         escapable_guard=True)
+
 
 class UnsupportedProperty(FslError):
     pass

@@ -3,8 +3,7 @@ from __future__ import annotations
 
 from fossil_dsl.plan.certificates.barrier import DEFAULT_LAYERS as BARRIER_LAYERS
 from fossil_dsl.plan.certificates.barrier import barrier_conditions
-from fossil_dsl.plan.certificates.base import (Certificate, Condition, next_in, register,
-                                               value_of)
+from fossil_dsl.plan.certificates.base import Certificate, register, value_of
 from fossil_dsl.plan.certificates.rwa import DEFAULT_LAYERS, reach_conditions
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
@@ -31,7 +30,6 @@ class ReachAvoidRemain(Certificate):
             return found
         # a step can jump out of D, where {B <= 0} says nothing: it must land in D
         domain = self.spec.domain
-        return found + (Condition(
-            "barrier_image", "f(x) ∈ D for every x in D with B(x) <= 0", domain,
-            next_in(self.spec.states, domain), guard=L.Compare("<=", value_of("B"), E.ZERO),
-            escapable_guard=True),)
+        return found + (self.lands_in("barrier_image", "f(x) ∈ D for every x in D with "
+                                      "B(x) <= 0", domain, domain,
+                                      L.Compare("<=", value_of("B"), E.ZERO)),)

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from fossil_dsl.plan.certificates.base import (Certificate, Condition, Level, change_of, level_of,
-                                               next_in, register, value_of)
+                                               register, value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.sets import Boundary
@@ -21,10 +21,8 @@ def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta
     inside_level = L.Compare("<=", V, beta)
     change = certificate.change_word(name)
     if certificate.discrete:
-        # met where f(x) lands in D, or by keeping the point out of Ω (V > β)
-        kept = Condition(f"{prefix}image", "f(x) ∈ D for every x in Ω", domain,
-                         next_in(certificate.spec.states, domain), guard=inside_level,
-                         escapable_guard=True)
+        kept = certificate.lands_in(f"{prefix}image", "f(x) ∈ D for every x in Ω", domain,
+                                    domain, inside_level)
     else:
         kept = Condition(f"{prefix}boundary", f"{name}(x) > β for every x on the boundary "
                          "of D", Boundary(domain), L.Compare(">", V, beta))

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from fossil_dsl.plan.certificates.base import (Certificate, Condition, Level, change_of, level_of,
-                                               next_in, register, value_of)
+                                               register, value_of)
 from fossil_dsl.plan.certificates.rwa import DEFAULT_LAYERS, GAMMA, reach_conditions
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
@@ -42,22 +42,21 @@ class ReachAndStayWhileAvoid(Certificate):
         step lands in S and lowers V by γ; from A, every step lands in A. (V > β on ∂F
         only places β, so that A is a sublevel set inside F: a step can jump over ∂F.)"""
         V, dV, beta = value_of("V"), change_of("V"), level_of("beta")
-        states, safe, final = self.spec.states, self.role("safe"), self.role("final")
-        in_a = L.conjunction(final.contains_formula(states), L.Compare("<=", V, beta))
+        safe, final = self.role("safe"), self.role("final")
+        in_a = L.conjunction(final.contains_formula(self.spec.states), L.Compare("<=", V, beta))
         outside_a = L.conjunction(L.Compare("<=", V, E.ZERO), L.negation(in_a))
         within = L.Compare("<=", V, beta)
         return (
             Condition("initial", "V(x) <= 0 for every x in I", self.role("initial"),
                       L.Compare("<=", V, E.ZERO)),
-            Condition("image", "f(x) ∈ S for every x in S with V(x) <= 0 outside "
-                      "A = F ∩ {V <= β}", safe, next_in(states, safe), guard=outside_a,
-                      escapable_guard=True),
+            self.lands_in("image", "f(x) ∈ S for every x in S with V(x) <= 0 outside "
+                          "A = F ∩ {V <= β}", safe, safe, outside_a),
             Condition("decrease", f"V(f(x)) - V(x) <= -{GAMMA} for every x in S with "
                       "V(x) <= 0 outside A", safe, L.Compare("<=", dV, E.Num(-GAMMA)),
                       guard=outside_a, escapable_guard=True),
             self._stay_boundary(" (it places β; the argument does not use it)"),
-            Condition("stay_image", "f(x) ∈ F for every x in F with V(x) <= β", final,
-                      next_in(states, final), guard=within, escapable_guard=True),
+            self.lands_in("stay_image", "f(x) ∈ F for every x in F with V(x) <= β", final,
+                          final, within),
             Condition("stay_level", "V(f(x)) <= β for every x in F with V(x) <= β", final,
                       L.Compare("<=", E.add(V, dV), beta), guard=within,
                       escapable_guard=True),

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from fossil_dsl.plan.certificates.base import (Certificate, Condition, change_of, next_in,
-                                               register, value_of)
+from fossil_dsl.plan.certificates.base import (Certificate, Condition, change_of, register,
+                                               value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.sets import Boundary, Difference, SetExpr
@@ -30,11 +30,9 @@ def reach_conditions(certificate: Certificate, safe: SetExpr, goal: SetExpr,
         L.Compare("<=", dV, E.Num(-GAMMA)), guard=L.Compare("<=", V, E.ZERO),
         escapable_guard=certificate.discrete)
     if certificate.discrete:
-        # met where f(x) lands in S, or by keeping the point out of {V <= 0}
-        kept = Condition(f"{prefix}image", f"f(x) ∈ {safe_words} for every x in "
-                         f"{safe_words} outside {goal_words} with {name}(x) <= 0",
-                         Difference(safe, goal), next_in(certificate.spec.states, safe),
-                         guard=L.Compare("<=", V, E.ZERO), escapable_guard=True)
+        kept = certificate.lands_in(f"{prefix}image", f"f(x) ∈ {safe_words} for every x in "
+                                    f"{safe_words} outside {goal_words} with {name}(x) <= 0",
+                                    Difference(safe, goal), safe, L.Compare("<=", V, E.ZERO))
         return initial, kept, decrease
     boundary = Condition(f"{prefix}boundary", f"{name}(x) > 0 for every x on the boundary "
                          f"of {safe_words}", Boundary(safe), L.Compare(">", V, E.ZERO))
