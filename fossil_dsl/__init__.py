@@ -5,6 +5,7 @@
     spec = fossil_dsl.load("specs/paper_lyapunov.fsl")     # a CheckedSpec
     result = fossil_dsl.check_file("spec.fsl")             # diagnostics as objects
     outcome = fossil_dsl.synthesise(spec, seed=1)          # learn and prove: a Result
+    outcome = fossil_dsl.race(spec, 4, cluster=None)       # 4 seeds race; the first wins
     outcome.sympy["V"], outcome.networks["V"]              # sympy formula, torch module
     outcome.save("out"); outcome.plot("portrait.png")      # artefacts, phase portrait
     spec = fossil_dsl.build_spec(...)                      # a spec built in Python
@@ -21,12 +22,12 @@ _LAZY = {"synthesise": "fossil_dsl.frontends.api", "Result": "fossil_dsl.outputs
          "BespokeSet": "fossil_dsl.frontends.build", "BuildError": "fossil_dsl.frontends.build",
          "build_spec": "fossil_dsl.frontends.build", "spec_text": "fossil_dsl.frontends.build",
          "OptionError": "fossil_dsl.frontends.arguments",
-         "load_result": "fossil_dsl.outputs.load", "LoadError": "fossil_dsl.outputs.load"}
+         "load_result": "fossil_dsl.outputs.load", "race": "fossil_dsl.frontends.portfolio", "LoadError": "fossil_dsl.outputs.load"}
 
 __all__ = ["BespokeSet", "BuildError", "CheckResult", "CheckedSpec", "Result", "build_spec",
            "spec_text", "Diagnostic", "FslError", "LoadError", "OptionError", "Severity", "SpecError",
            "SpecSyntaxError", "check_file", "check_source", "check_text", "load", "loads",
-           "load_result", "parse", "synthesise", "__version__"]
+           "load_result", "parse", "race", "synthesise", "__version__"]
 
 
 def __getattr__(name: str):

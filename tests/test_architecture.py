@@ -25,8 +25,10 @@ ALLOWED = {
     "outputs": {"version", "diagnostics", "ir", "syntax", "check", "plan", "engine", "solvers",
                 "kernel"},
     "extend": {"ir", "check", "plan", "kernel"},
+    # jobs and where they run (local processes, Dask workers): data in, data out
+    "cluster": {"version", "ir", "solvers"},
     "frontends": {"version", "diagnostics", "ir", "syntax", "check", "plan", "engine",
-                  "outputs", "solvers", "kernel"},
+                  "outputs", "solvers", "kernel", "cluster"},
 }
 MAX_LINES = 350
 

@@ -48,6 +48,17 @@ def solver_name(value) -> str:
     return value
 
 
+SCHEDULER = re.compile(r"((tcp|tls|ucx)://)?[\w.\-]+:\d{1,5}|((tcp|tls)://)?\[[0-9a-fA-F:]+\]:\d{1,5}")
+
+
+def scheduler_address(value) -> str:
+    """A Dask scheduler's address: tcp://HOST:PORT (the scheme may be left out)."""
+    text = value.strip() if isinstance(value, str) else ""
+    if not SCHEDULER.fullmatch(text):
+        raise OptionError(f"a Dask scheduler's address looks like tcp://HOST:PORT, not {value!r}")
+    return text if "://" in text else "tcp://" + text
+
+
 def writable_directory(value) -> Path:
     """The folder, created if need be, and shown writable by writing a file in it."""
     folder = Path(value)
@@ -87,6 +98,7 @@ SECONDS = argument(positive, "the time in seconds")
 SOLVER = argument(solver_name)
 FOLDER = argument(writable_directory)
 FILE = argument(writable_file)
+SCHEDULER_ADDRESS = argument(scheduler_address)
 
 # ---- the Python API's keyword options --------------------------------------------
 API_CHECKS = {

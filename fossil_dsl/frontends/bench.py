@@ -1,4 +1,5 @@
-"""`fossilc bench`: every spec × seed in its own process, J at a time; a table in the
+"""`fossilc bench`: every spec × seed in its own process, J at a time (or on the workers
+of a Dask scheduler, `--cluster`); a table in the
 style of the tool paper's (success rate, times over successful runs, learning against
 verification), written as CSV (one row per run) and Markdown (one row per spec).
 
@@ -11,15 +12,13 @@ import json
 import os
 import platform
 import statistics
-import subprocess
-import sys
-import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from datetime import date
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
+from fossil_dsl.cluster.executors import Executor, LocalExecutor
+from fossil_dsl.cluster.jobs import GRACE, Job, JobOutput
 from fossil_dsl.frontends.api import load
 from fossil_dsl.diagnostics import FslError
 from fossil_dsl.plan.compile import compile_spec
@@ -38,6 +37,8 @@ class Run:
     iterations: int | None = None
     wall: float = 0.0  # seconds of the whole process, start-up included
     detail: str = ""
+    worker: str = "local"  # where it ran (a Dask worker's address with --cluster)
+    attempts: int = 1  # times it was started: more when its worker was lost
 
 
 @dataclass(frozen=True)
@@ -72,31 +73,35 @@ def describe(path: Path, verifier: str | None) -> SpecInfo:
                     spec.property.certificate, " | ".join(networks), plan.verifier)
 
 
-def run_one(path: Path, seed: int, verifier: str | None, timeout: float, name: str) -> Run:
-    command = [sys.executable, "-m", "fossil_dsl.frontends.cli", str(path), "--json", "-q",
-               "--seed", str(seed), "--timeout", str(timeout)]
-    if verifier:
-        command += ["--verifier", verifier]
-    started = time.monotonic()
+def job_for(path: Path, seed: int, verifier: str | None, timeout: float, name: str) -> Job:
+    return Job(path.read_text("utf-8"), path.stem, seed, timeout, verifier,
+               label=f"{name} seed {seed}")
+
+
+def run_from(output: JobOutput, job: Job, name: str, path: Path) -> Run:
+    """A job's output as a table's run."""
+    seed, wall, attempts = job.seed, output.wall, output.attempts
+    where = {"worker": output.worker, "attempts": attempts}
+    if output.worker == "lost":
+        return Run(name, str(path), seed, "crashed", wall=wall, detail=_last_line(output.stderr),
+                   **where)
+    if output.returncode is None:
+        return Run(name, str(path), seed, "timeout", wall=wall,
+                   detail=f"killed after {job.timeout + GRACE:g} s", **where)
+    if output.returncode == 2:
+        return Run(name, str(path), seed, "bad spec", wall=wall,
+                   detail=_last_line(output.stderr), **where)
     try:
-        done = subprocess.run(command, capture_output=True, text=True, timeout=timeout + 60)
-    except subprocess.TimeoutExpired:
-        return Run(name, str(path), seed, "timeout", wall=time.monotonic() - started,
-                   detail=f"killed after {timeout + 60:g} s")
-    wall = time.monotonic() - started
-    if done.returncode == 2:
-        return Run(name, str(path), seed, "bad spec", wall=wall, detail=_last_line(done.stderr))
-    try:
-        data = json.loads(done.stdout)
+        data = json.loads(output.stdout)
     except json.JSONDecodeError:
         return Run(name, str(path), seed, "crashed", wall=wall,
-                   detail=f"exit {done.returncode}: {_last_line(done.stderr)}")
+                   detail=f"exit {output.returncode}: {_last_line(output.stderr)}", **where)
     outcome = data["verdict"]
     if outcome != "certified" and data["reason"].startswith("timeout"):
         outcome = "timeout"
     seconds = data["seconds"]
     return Run(name, str(path), seed, outcome, seconds["total"], seconds["learn"],
-               seconds["verify"], data["iterations"], wall, data["reason"])
+               seconds["verify"], data["iterations"], wall, data["reason"], **where)
 
 
 def _last_line(text: str) -> str:
@@ -105,20 +110,21 @@ def _last_line(text: str) -> str:
 
 
 def run_all(paths: Sequence[Path], seeds: int, jobs: int, verifier: str | None,
-            timeout: float, progress: Callable[[Run], None] = lambda run: None
-            ) -> tuple[list[SpecInfo], list[Run]]:
+            timeout: float, progress: Callable[[Run], None] = lambda run: None,
+            executor: Executor | None = None) -> tuple[list[SpecInfo], list[Run]]:
+    """Every spec × seed, on `executor` (default: `jobs` local processes)."""
     infos = [describe(path, verifier) for path in paths]
     tasks = [(path, seed, info.name) for path, info in zip(paths, infos)
              for seed in range(seeds)]
+    work = [job_for(path, seed, verifier, timeout, name) for path, seed, name in tasks]
+    runs: list[Run | None] = [None] * len(work)
 
-    def one(task) -> Run:
-        path, seed, name = task
-        run = run_one(path, seed, verifier, timeout, name)
-        progress(run)
-        return run
+    def done(index: int, output: JobOutput) -> None:
+        path, _, name = tasks[index]
+        runs[index] = run_from(output, work[index], name, path)
+        progress(runs[index])
 
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        runs = list(pool.map(one, tasks))
+    (executor or LocalExecutor(jobs)).run(work, done)
     return infos, runs
 
 
@@ -143,16 +149,22 @@ def table_rows(infos: Sequence[SpecInfo], runs: Sequence[Run]) -> list[list[str]
     return rows
 
 
-def markdown(infos, runs, command: str) -> str:
+def markdown(infos, runs, command: str, where: str = "") -> str:
     rows = table_rows(infos, runs)
-    lines = [f"Run on {date.today().isoformat()}, {platform.node() or 'this machine'} "
-             f"({platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}), "
+    machine = where or f"{platform.node() or 'this machine'} ({platform.machine()}, " \
+        f"{os.cpu_count()} cores, Python {platform.python_version()})"
+    lines = [f"Run on {date.today().isoformat()}, {machine}, "
              f"fossil_dsl {__version__}; command: `{command}`.",
              "Times are the runs' own (check excluded, process start-up excluded), over "
              "successful runs only.", "",
              "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |"
               for row in rows]
+    retried = [r for r in runs if r.attempts > 1]
+    if retried:
+        lines += ["", "Runs started again after their worker was lost:", ""]
+        lines += [f"- {r.spec} seed {r.seed}: {r.attempts} starts, finished on {r.worker}"
+                  for r in retried]
     failures = [r for r in runs if r.outcome != "certified"]
     if failures:
         lines += ["", "Runs not certified:", ""]
@@ -160,7 +172,7 @@ def markdown(infos, runs, command: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write(out: Path, infos, runs, command: str) -> tuple[Path, Path]:
+def write(out: Path, infos, runs, command: str, where: str = "") -> tuple[Path, Path]:
     out.mkdir(parents=True, exist_ok=True)
     runs_csv = out / "runs.csv"
     with runs_csv.open("w", newline="") as handle:
@@ -169,7 +181,7 @@ def write(out: Path, infos, runs, command: str) -> tuple[Path, Path]:
             writer.writeheader()
             writer.writerows(asdict(r) for r in runs)
     table = out / "table.md"
-    table.write_text(markdown(infos, runs, command))
+    table.write_text(markdown(infos, runs, command, where))
     with (out / "table.csv").open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(COLUMNS)

@@ -18,11 +18,13 @@ from pathlib import Path
 from typing import Sequence
 
 from rich.console import Console
-from rich.progress import Progress, TextColumn
 
 from fossil_dsl.diagnostics import error
 from fossil_dsl.frontends import arguments
-from fossil_dsl.frontends.checking import CheckResult, check_file, check_text
+from fossil_dsl.frontends.checking import CheckResult, check_file
+from fossil_dsl.frontends.console import (EXIT_BAD_SPEC, EXIT_INTERNAL, EXIT_INTERRUPTED,
+                                          EXIT_OK, consoles, report)
+from fossil_dsl.frontends.tools import bench_parser, import_yaml_parser, recheck_parser
 from fossil_dsl.plan.compile import CompileError, compile_spec
 from fossil_dsl.plan.readable import loss_text, plan_text, symbolic_queries
 from fossil_dsl.solvers.registry import BackendUnavailable
@@ -31,32 +33,13 @@ from fossil_dsl.version import __version__
 # Learning, plotting, benchmarks and YAML import are imported by the commands that use
 # them: `fossilc --help` and `fossilc check` import no torch, sympy or matplotlib.
 
-EXIT_OK, EXIT_BAD_SPEC, EXIT_INTERNAL = 0, 2, 3  # 1 (not certified) comes from the result
-EXIT_INTERRUPTED = 130  # Ctrl-C, as shells report SIGINT
-
-
-def _consoles() -> tuple[Console, Console]:
-    return Console(highlight=False, soft_wrap=True), \
-        Console(stderr=True, highlight=False, soft_wrap=True)
-
-
-def _report(result: CheckResult, out: Console, err: Console, quiet: bool,
-            summary: bool = True) -> None:
-    for diagnostic in result.diagnostics:
-        if quiet and not diagnostic.is_error:
-            continue
-        style = "red" if diagnostic.is_error else "yellow"
-        err.print(diagnostic.render(result.source), style=style, markup=False)
-    if result.ok and summary:
-        out.print(f"ok: {result.source.path}: {result.spec.summary()}", markup=False)
-
 
 def command_check(args: argparse.Namespace) -> int:
-    out, err = _consoles()
+    out, err = consoles()
     good = True
     for path in args.specs:
         result = check_file(path)
-        _report(result, out, err, args.quiet)
+        report(result, out, err, args.quiet)
         good = good and result.ok and _report_verifier(result, out, err)
     return EXIT_OK if good else EXIT_BAD_SPEC
 
@@ -76,16 +59,21 @@ def command_run(args: argparse.Namespace) -> int:
     from fossil_dsl.frontends.api import synthesise
     from fossil_dsl.outputs.artefacts import write_artefacts
     from fossil_dsl.outputs.summary import summary_text
-    out, err = _consoles()
+    out, err = consoles()
     result = check_file(args.spec)
-    _report(result, out, err, args.quiet or args.json, summary=not args.json)
+    report(result, out, err, args.quiet or args.json, summary=not args.json)
     if not result.ok:
         return EXIT_BAD_SPEC
     overrides = {"verifier": args.verifier, "seed": args.seed, "max_iters": args.max_iters,
                  "timeout": args.timeout, "learn_only": args.learn_only or None}
     try:
-        with _display(args, out, err) as listener:
-            outcome = synthesise(result.spec, progress=listener, **overrides)
+        if args.portfolio or args.cluster:
+            outcome = _race(result.spec, args, overrides, err)
+            if outcome is None:
+                return EXIT_BAD_SPEC
+        else:
+            with _display(args, out, err) as listener:
+                outcome = synthesise(result.spec, progress=listener, **overrides)
     except (CompileError, BackendUnavailable) as exc:
         _compile_error(exc, result, err)
         return EXIT_BAD_SPEC
@@ -99,6 +87,39 @@ def command_run(args: argparse.Namespace) -> int:
         style = "bold green" if outcome.certified else "bold red"
         out.print(summary_text(outcome), style=style if args.quiet else None, markup=False)
     return outcome.exit_code
+
+
+def _race(spec, args: argparse.Namespace, overrides: dict, err: Console):
+    """The portfolio's Result, or None after saying why it cannot run."""
+    from fossil_dsl.cluster.executors import ClusterError, LocalExecutor, executor_for
+    from fossil_dsl.frontends.portfolio import PortfolioError, race
+    count = args.portfolio or 1
+    if args.learn_only:
+        err.print("fossilc: --portfolio and --cluster race strategies to a certificate; "
+                  "--learn-only proves nothing (run it alone)", style="red", markup=False)
+        return None
+    try:
+        executor = executor_for(args.cluster, count) if args.cluster else LocalExecutor(count)
+    except ClusterError as exc:
+        err.print(f"fossilc: {exc}", style="red", markup=False)
+        return None
+    talk = not (args.quiet or args.json)
+    if talk:
+        err.print(f"racing {count} strateg{'y' if count == 1 else 'ies'} on "
+                  f"{executor.description}", markup=False)
+
+    def finished(report) -> None:
+        if talk:
+            err.print(f"  {report.strategy}: {report.verdict} after {report.seconds:.1f} s"
+                      + (f" ({report.detail})" if report.verdict not in ("certified", "stopped")
+                         else ""), markup=False)
+    try:
+        return race(spec, count, executor, finished, **overrides)
+    except PortfolioError as exc:
+        err.print(f"fossilc: {exc}", style="red", markup=False)
+        return None
+    finally:
+        executor.close()
 
 
 def _write_plots(outcome, args: argparse.Namespace, err: Console) -> bool:
@@ -134,9 +155,9 @@ def _display(args: argparse.Namespace, out: Console, err: Console):
 
 
 def command_compile(args: argparse.Namespace) -> int:
-    out, err = _consoles()
+    out, err = consoles()
     result = check_file(args.spec)
-    _report(result, out, err, quiet=True)
+    report(result, out, err, quiet=True)
     if not result.ok:
         return EXIT_BAD_SPEC
     try:
@@ -175,6 +196,12 @@ def _run_parser() -> argparse.ArgumentParser:
     parser.add_argument("--learn-only", action="store_true",
                         help="train without verifying; report how many fresh samples "
                         "violate each condition (nothing is proved)")
+    parser.add_argument("--portfolio", metavar="N", type=arguments.COUNT,
+                        help="race N strategies (seeds S, S+1, ...) in parallel processes; "
+                        "the first the kernel certifies wins, the others are stopped")
+    parser.add_argument("--cluster", metavar="ADDRESS", type=arguments.SCHEDULER_ADDRESS,
+                        help="run the strategies on the workers of the Dask scheduler at "
+                        "tcp://HOST:PORT (needs the [cluster] extra)")
     parser.add_argument("--plot", action="store_true",
                         help="draw the phase portrait (2- and 3-state specs) as PNG and SVG: "
                         "DIR/phase_portrait.* with -o DIR, else SPECNAME_portrait.*")
@@ -210,115 +237,8 @@ def _check_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def command_bench(args: argparse.Namespace) -> int:
-    from fossil_dsl.frontends import bench
-    out, err = _consoles()
-    paths = bench.spec_files(args.paths)
-    if not paths:
-        err.print("fossilc bench: no .fsl files found", style="red")
-        return EXIT_BAD_SPEC
-    total = len(paths) * args.seeds
-    with Progress(*Progress.get_default_columns(), TextColumn("{task.fields[last]}"),
-                  console=err, transient=True) as progress:
-        task = progress.add_task("benchmarks", total=total, last="")
-
-        def advance(run) -> None:
-            progress.update(task, advance=1, last=f"{run.spec} seed {run.seed}: {run.outcome}")
-
-        infos, runs = bench.run_all(paths, args.seeds, args.jobs, args.verifier,
-                                    args.timeout, advance)
-    command = (f"fossilc bench {' '.join(args.paths)} --seeds {args.seeds} --jobs {args.jobs} "
-               f"--timeout {args.timeout:g} --out {args.out}"
-               + (f" --verifier {args.verifier}" if args.verifier else ""))
-    runs_csv, table = bench.write(Path(args.out), infos, runs, command)
-    out.print(table.read_text(), markup=False)
-    out.print(f"written: {runs_csv}, {table}, {table.with_suffix('.csv')}", markup=False)
-    return EXIT_OK
-
-
-def _bench_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="fossilc bench",
-                                     description="Run specs with several seeds, each in its "
-                                     "own process, and tabulate success and time.")
-    parser.add_argument("paths", nargs="+", metavar="FILE_OR_DIR", help=".fsl files or folders")
-    parser.add_argument("--seeds", type=arguments.COUNT, default=10,
-                        help="seeds 0..N-1 (default 10)")
-    parser.add_argument("--jobs", type=arguments.COUNT, default=1,
-                        help="runs at a time (default 1)")
-    parser.add_argument("--verifier", type=arguments.SOLVER,
-                        help="z3, cvc5, dreal or interval (default: per spec)")
-    parser.add_argument("--timeout", type=arguments.SECONDS, default=600.0,
-                        help="seconds per run (default 600)")
-    parser.add_argument("--out", default="benchmarks/results/latest", type=arguments.FOLDER,
-                        help="folder for runs.csv, table.csv and table.md")
-    parser.set_defaults(handler=command_bench)
-    return parser
-
-
-def command_recheck(args: argparse.Namespace) -> int:
-    from fossil_dsl.outputs import recheck
-    out, err = _consoles()
-    try:
-        checks = recheck.recheck(args.directory, args.timeout, args.solver)
-    except (recheck.RecheckError, BackendUnavailable) as exc:
-        err.print(f"fossilc recheck: {exc}", style="red", markup=False)
-        return EXIT_BAD_SPEC
-    out.print(recheck.report_text(checks), markup=False)
-    return EXIT_OK if all(c.reproved for c in checks) else 1
-
-
-def _recheck_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="fossilc recheck", description="Re-prove the SMT-LIB 2 obligations of a "
-        "result folder (written by `fossilc SPEC -o DIR`), each with an installed solver "
-        "other than the one that proved it. Exit 0 if every one is re-proved, 1 if not.")
-    parser.add_argument("directory", metavar="DIR", help="the folder `-o DIR` wrote")
-    parser.add_argument("--solver", type=arguments.SOLVER,
-                        help="use this solver for every obligation "
-                        "(default: the first suitable one that did not prove it)")
-    parser.add_argument("--timeout", type=arguments.SECONDS, default=60.0,
-                        help="seconds per obligation (default 60)")
-    parser.set_defaults(handler=command_recheck)
-    return parser
-
-
-def command_import_yaml(args: argparse.Namespace) -> int:
-    from fossil_dsl.frontends import yaml_import
-    out, err = _consoles()
-    path = Path(args.config)
-    try:
-        translation = yaml_import.import_yaml(path.read_text("utf-8"), path.stem)
-    except (OSError, UnicodeDecodeError) as exc:
-        err.print(f"fossilc import-yaml: cannot read {path}: {exc}", style="red", markup=False)
-        return EXIT_BAD_SPEC
-    except yaml_import.YamlImportError as exc:
-        err.print(f"fossilc import-yaml: {path}: {exc}", style="red", markup=False)
-        return EXIT_BAD_SPEC
-    for note in translation.notes:
-        err.print(f"{path}: note: {note}", style="yellow", markup=False)
-    target = args.output or "<translated>"
-    if args.output:
-        Path(args.output).write_text(translation.text)
-    else:
-        out.print(translation.text, markup=False, end="")
-    checked = check_text(translation.text, target)
-    _report(checked, out if args.output else err, err, quiet=False, summary=bool(args.output))
-    return EXIT_OK if checked.ok else EXIT_BAD_SPEC
-
-
-def _import_yaml_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="fossilc import-yaml", description="Translate a Fossil 2.0 YAML configuration "
-        "into a .fsl spec, say what could not be translated, and check the result.")
-    parser.add_argument("config", metavar="CONFIG.yaml")
-    parser.add_argument("-o", "--output", metavar="SPEC.fsl", type=arguments.FILE,
-                        help="write the spec here (default: print it)")
-    parser.set_defaults(handler=command_import_yaml)
-    return parser
-
-
-COMMANDS = {"check": _check_parser, "compile": _compile_parser, "bench": _bench_parser,
-            "recheck": _recheck_parser, "import-yaml": _import_yaml_parser}
+COMMANDS = {"check": _check_parser, "compile": _compile_parser, "bench": bench_parser,
+            "recheck": recheck_parser, "import-yaml": import_yaml_parser}
 
 
 def parse_arguments(argv: Sequence[str]) -> argparse.Namespace:

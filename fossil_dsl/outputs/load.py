@@ -53,7 +53,8 @@ def load_result(directory: str | Path, judge_again: bool = True, timeout: float 
                   float(seconds.get("learn", 0)), float(seconds.get("verify", 0)),
                   float(seconds.get("total", 0)), int(data.get("digits", 3)),
                   _networks(folder, plan), verdict, bool(data.get("interrupted", False)),
-                  str(data.get("strategy", "learning")), claim.refutations)
+                  str(data.get("strategy", "learning")), claim.refutations,
+                  data.get("portfolio", {}))
 
 
 def _plan(data: dict) -> Plan:

@@ -55,6 +55,7 @@ class Result:
     interrupted: bool = False  # stopped by Ctrl-C (the shell's exit code 130)
     strategy: str = "learning"  # how the functions were found (not part of any proof)
     refutations: dict = field(default_factory=dict)  # obligation -> sum-of-squares evidence
+    portfolio: dict = field(default_factory=dict)  # the race that found it (--portfolio)
 
     @property
     def verdict(self) -> str:
@@ -142,6 +143,7 @@ class Result:
             "learn_only": self.learn_only,
             "interrupted": self.interrupted,
             "strategy": self.strategy,
+            **({"portfolio": self.portfolio} if self.portfolio else {}),
             "conditions": [_condition_json(c) for c in self.conditions],
             "kernel": kernel_json(self.kernel),
             "verifier": plan.verifier,

@@ -38,12 +38,22 @@ def summary_text(result: Result) -> str:
     if result.certified:
         lines += [f"  assumes: {a}" for a in result.assumptions()]
     lines.append(f"  found by: {result.strategy}")
+    if result.portfolio:
+        lines.append(f"  portfolio: {portfolio_line(result.portfolio)}")
     verifier = "no verifier (learn-only)" if result.learn_only else f"verifier {plan.verifier}"
     lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
                  f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"
                  f"{'' if result.iterations == 1 else 's'}, {verifier}, "
                  f"seed {plan.options.seed}")
     return "\n".join(lines)
+
+
+def portfolio_line(record: dict) -> str:
+    outcomes = ", ".join(f"{s['strategy']} {s['outcome']}" for s in record["strategies"])
+    line = f"{outcomes} ({record['where']}, {record['seconds']:.2f} s)"
+    if record.get("repeat"):
+        line += f"; repeat the winner alone with {record['repeat']}"
+    return line
 
 
 def kernel_lines(verdict: Verdict) -> list[str]:
