@@ -9,6 +9,7 @@ from fossil_dsl.frontends.checking import (CheckResult, check_file, check_source
                                            load, loads, parse)
 from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.attempts import run_attempts
+from fossil_dsl.engine.split import SplitBackend
 from fossil_dsl.plan.compile import Plan, compile_spec
 from fossil_dsl.kernel import Verdict, judge, not_certified
 from fossil_dsl.outputs.result import Result, build_result, claim_of
@@ -22,33 +23,37 @@ __all__ = ["BespokeSet", "BuildError", "CheckResult", "OptionError", "build_spec
            "check_source", "check_text", "load", "loads", "parse", "spec_text", "synthesise"]
 
 
-def synthesise(spec: CheckedSpec, progress=None, certificate=None, **options) -> Result:
+def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
+               **options) -> Result:
     """Compile a checked spec and run CEGIS. `options` override the synthesis block:
     verifier, seed, max_iters, timeout, learning_rate, margin, digits, query_timeout,
     delta (precision of a delta-decision verifier), learn_only (train, report violation
     rates on fresh samples, prove nothing).
-    `certificate` is a Certificate subclass to use instead of the registered one."""
+    `certificate` is a Certificate subclass to use instead of the registered one.
+    `pieces` (cluster.pieces.LocalPieces or DaskPieces) splits the interval procedure's
+    queries, in the loop and in the kernel, into pieces checked in parallel."""
     options = check_options(options)  # a bad value raises OptionError before any work
     plan = compile_spec(spec, certificate=certificate, **options)
     if not verifier_only(plan):
         from fossil_dsl.engine.learner import import_optimiser_support
         import_optimiser_support()
     started = time.monotonic()
-    backend = None if plan.options.learn_only else _backend(plan)
+    backend = None if plan.options.learn_only else _backend(plan, pieces)
     plan, outcome = run_attempts(plan, backend, progress)
-    return build_result(plan, outcome, _judge(plan, outcome), time.monotonic() - started)
+    return build_result(plan, outcome, _judge(plan, outcome, pieces),
+                        time.monotonic() - started)
 
 
-def _judge(plan: Plan, outcome) -> Verdict:
+def _judge(plan: Plan, outcome, pieces=None) -> Verdict:
     """The kernel's verdict on the engine's final formulas (judged afresh from the spec
     and those formulas alone; the engine's own answers are not used)."""
     if not outcome.certified:
         return not_certified(outcome.reason)
     return judge(claim_of(plan, outcome), timeout=plan.options.query_timeout,
-                 delta=plan.options.delta)
+                 delta=plan.options.delta, pieces=pieces)
 
 
-def _backend(plan: Plan):
+def _backend(plan: Plan, pieces=None):
     """The plan's verifier, raced by its fallback where it has one. For polynomial
     problems a sum-of-squares refutation is tried too: before the solvers from
     BEFORE_Z3_FROM states on, else by the fallback before its own procedure (so only
@@ -58,10 +63,14 @@ def _backend(plan: Plan):
     Z3 and the interval search each spent 30 s without an answer (given the head start
     over the fallback, it cost the portfolio's reach-type rows 1 to 3 s of verifying)."""
     from fossil_dsl.solvers.sos_refutation import RefutationFirst
-    backend = registry.load(plan.verifier, plan.options.delta)
+
+    def load(name: str):
+        backend = registry.load(name, plan.options.delta)
+        return SplitBackend(backend, pieces) if pieces and name == "interval" else backend
+    backend = load(plan.verifier)
     polynomial, many = plan.verifier == "z3", len(plan.states) >= BEFORE_Z3_FROM
     if plan.fallback:
-        fallback = registry.load(plan.fallback, plan.options.delta)
+        fallback = load(plan.fallback)
         if polynomial and not many:
             fallback = RefutationFirst(fallback)
         if polynomial and plan.fallback != "cvc5" and registry.is_installed("cvc5"):

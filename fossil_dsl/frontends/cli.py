@@ -67,15 +67,17 @@ def command_run(args: argparse.Namespace) -> int:
     overrides = {"verifier": args.verifier, "seed": args.seed, "max_iters": args.max_iters,
                  "timeout": args.timeout, "learn_only": args.learn_only or None}
     try:
-        if args.portfolio or args.cluster:
+        if args.split:
+            outcome = _split_run(result.spec, args, overrides, out, err)
+        elif args.portfolio or args.cluster:
             outcome = _race(result.spec, args, overrides, err)
-            if outcome is None:
-                return EXIT_BAD_SPEC
         else:
             with _display(args, out, err) as listener:
                 outcome = synthesise(result.spec, progress=listener, **overrides)
     except (CompileError, BackendUnavailable) as exc:
         _compile_error(exc, result, err)
+        return EXIT_BAD_SPEC
+    if outcome is None:
         return EXIT_BAD_SPEC
     if args.output:
         write_artefacts(outcome, args.output)
@@ -87,6 +89,35 @@ def command_run(args: argparse.Namespace) -> int:
         style = "bold green" if outcome.certified else "bold red"
         out.print(summary_text(outcome), style=style if args.quiet else None, markup=False)
     return outcome.exit_code
+
+
+def _split_run(spec, args: argparse.Namespace, overrides: dict, out: Console, err: Console):
+    """One run whose interval queries are split into pieces checked in parallel by
+    --split N local processes, or by the workers of --cluster; None after saying why it
+    cannot run."""
+    from fossil_dsl.cluster.executors import ClusterError, DaskExecutor
+    from fossil_dsl.cluster.pieces import DaskPieces, LocalPieces
+    from fossil_dsl.frontends.api import synthesise
+    if args.portfolio:
+        err.print("fossilc: --split and --portfolio both use the workers: choose one",
+                  style="red", markup=False)
+        return None
+    try:
+        executor = DaskExecutor(args.cluster) if args.cluster else None
+    except ClusterError as exc:
+        err.print(f"fossilc: {exc}", style="red", markup=False)
+        return None
+    pieces = DaskPieces(executor.client) if executor else LocalPieces(args.split)
+    if not (args.quiet or args.json):
+        err.print(f"interval queries split into {pieces.pieces + 1} pieces on "
+                  f"{pieces.description}", markup=False)
+    try:
+        with _display(args, out, err) as listener:
+            return synthesise(spec, progress=listener, pieces=pieces, **overrides)
+    finally:
+        pieces.close()
+        if executor:
+            executor.close()
 
 
 def _race(spec, args: argparse.Namespace, overrides: dict, err: Console):
@@ -200,8 +231,13 @@ def _run_parser() -> argparse.ArgumentParser:
                         help="race N strategies (seeds S, S+1, ...) in parallel processes; "
                         "the first the kernel certifies wins, the others are stopped")
     parser.add_argument("--cluster", metavar="ADDRESS", type=arguments.SCHEDULER_ADDRESS,
-                        help="run the strategies on the workers of the Dask scheduler at "
-                        "tcp://HOST:PORT (needs the [cluster] extra)")
+                        help="run the strategies (or, with --split, the pieces) on the "
+                        "workers of the Dask scheduler at tcp://HOST:PORT (needs the "
+                        "[cluster] extra)")
+    parser.add_argument("--split", metavar="N", type=arguments.COUNT,
+                        help="split the interval procedure's queries (in the loop and in "
+                        "the kernel) into pieces checked by N local processes, or by the "
+                        "workers of --cluster")
     parser.add_argument("--plot", action="store_true",
                         help="draw the phase portrait (2- and 3-state specs) as PNG and SVG: "
                         "DIR/phase_portrait.* with -o DIR, else SPECNAME_portrait.*")

@@ -66,7 +66,10 @@ SHARES = {"z3": 0.3, SUM_OF_SQUARES: 0.1, "interval": 0.4, "cvc5": 0.2}
 
 
 def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
-              delta: float | None = None, first: str = "", refutation=None) -> Proof:
+              delta: float | None = None, first: str = "", refutation=None,
+              pieces=None) -> Proof:
+    """`pieces`, if given, checks queries in parallel (cluster/pieces.py): the interval
+    procedure then splits the query into a cover (kernel/cover.py)."""
     query = obligation.query
     exact = L.truth(query)
     if exact is not None:
@@ -76,11 +79,12 @@ def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
         return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES, GIVEN_REFUTATION,
                      evidence=refutation)
     if is_arithmetic(query):
-        return _arithmetic(obligation, states, timeout, delta, first)
-    return _interval(obligation, states, timeout, delta)
+        return _arithmetic(obligation, states, timeout, delta, first, pieces)
+    return _interval(obligation, states, timeout, delta, pieces)
 
 
-def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str) -> Proof:
+def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str,
+                pieces) -> Proof:
     early = len(states) >= BEFORE_Z3_FROM  # the refutation before Z3
     order = sorted(SHARES, key=lambda name: (name != first,
                                              not (early and name == SUM_OF_SQUARES)))
@@ -88,7 +92,7 @@ def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: st
     for name in order:
         budget = max(1.0, SHARES[name] * timeout)
         if name == "interval":
-            proof = _interval(obligation, states, budget, delta)
+            proof = _interval(obligation, states, budget, delta, pieces)
             if proof.proved:
                 return proof
             reasons.append(f"interval: {proof.detail}")
@@ -110,14 +114,42 @@ def _solver(name: str):
     return {"z3": Z3Backend, "cvc5": Cvc5Backend, SUM_OF_SQUARES: SosBackend}[name]()
 
 
-def _interval(obligation: Obligation, states, timeout: float, delta) -> Proof:
+def _interval(obligation: Obligation, states, timeout: float, delta, pieces=None) -> Proof:
     from fossil_dsl.solvers.interval_backend import IntervalBackend
+    split = _split(obligation, states, timeout, delta, pieces) if pieces else None
+    if split is not None:
+        return split
     backend = IntervalBackend(delta) if delta else IntervalBackend()
     answer = backend.check(obligation.query, states, timeout)
     if answer.status is Status.UNSAT:
         return Proof(obligation, Outcome.PROVED, "interval")
     return Proof(obligation, Outcome.NOT_PROVED, "interval", _reason(answer),
                  _point(answer, states))
+
+
+def _split(obligation: Obligation, states, timeout: float, delta, pieces) -> Proof | None:
+    """The interval procedure on the pieces of a checked cover, in parallel; None where
+    the query has no bounded hull to split (the one search then decides)."""
+    from fossil_dsl.kernel import cover
+    names = [s for s in states if s in L.free_vars(obligation.query)]
+    hull = cover.hull_of(obligation.query, names)
+    if hull is None:
+        return None
+    boxes = cover.bisected(hull, pieces.pieces)
+    procedure = f"interval, split into {len(boxes) + 1} pieces"
+    problem = cover.covers(hull, boxes)
+    if problem:
+        return Proof(obligation, Outcome.NOT_PROVED, procedure, f"not a cover: {problem}")
+    queries = cover.pieces(obligation.query, names, hull, boxes)
+    answers = pieces.check_all(queries, names, timeout, delta)
+    if len(answers) != len(queries):
+        return Proof(obligation, Outcome.NOT_PROVED, procedure,
+                     f"{len(answers)} answers for {len(queries)} pieces")
+    failed = next((a for a in answers if a.status is not Status.UNSAT), None)
+    if failed is None:
+        return Proof(obligation, Outcome.PROVED, procedure)
+    return Proof(obligation, Outcome.NOT_PROVED, procedure, _reason(failed),
+                 _point(failed, states))
 
 
 def _point(answer: Answer, states) -> tuple[Fraction, ...] | None:

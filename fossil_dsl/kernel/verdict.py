@@ -49,20 +49,22 @@ def list_obligations(claim: Claim, strengthened: str | None = None) -> list[Obli
 
 
 def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
-          delta: float | None = None) -> Verdict:
-    """Prove every obligation; stop at the first that is not proved."""
+          delta: float | None = None, pieces=None) -> Verdict:
+    """Prove every obligation; stop at the first that is not proved. `pieces` checks
+    the pieces of split interval queries in parallel (their cover is checked here)."""
     started = time.monotonic()
     try:
         found, guarantee = derive_facts(claim)
     except NoRule as exc:
         return not_certified(f"the kernel cannot judge this claim: {exc}")
-    proofs, proved = _prove_all(found, claim, timeout, delta)
+    proofs, proved = _prove_all(found, claim, timeout, delta, pieces)
     if not proved:
         return Verdict(False, _failure_text(proofs[-1]), tuple(proofs),
                        time.monotonic() - started)
     strengthened = None
     for option, extra, stronger in derive_strengthenings(claim):
-        more, proved = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta)
+        more, proved = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta,
+                                  pieces)
         if proved:
             proofs += more
             guarantee, strengthened = stronger, option.name
@@ -72,14 +74,14 @@ def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
 
 
 def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
-               delta: float | None) -> tuple[list[Proof], bool]:
+               delta: float | None, pieces=None) -> tuple[list[Proof], bool]:
     """The proofs up to the first obligation not proved, and whether all were proved.
     The procedure that proved a condition in the run goes first (only the order)."""
     proofs = []
     for obligation in obligations:
         first = claim.procedures.get(obligation.name.removeprefix("condition:"), "")
         proofs.append(discharge(obligation, claim.spec.states, timeout, delta, first,
-                                claim.refutations.get(obligation.name)))
+                                claim.refutations.get(obligation.name), pieces))
         if not proofs[-1].proved:
             return proofs, False
     return proofs, True

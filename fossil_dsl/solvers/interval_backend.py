@@ -91,6 +91,23 @@ class IntervalBackend:
         return Answer(Status.UNSAT)
 
 
+def hull(formula: L.Formula, names: Sequence[str]) -> list[tuple[float, float]] | None:
+    """The box contraction leaves of the whole space (outward-rounded), per name; None
+    if it is empty or unbounded, or the formula is outside the procedure's theory."""
+    with upward_rounding() as codac:
+        try:
+            contractor = _Compiler(codac, names).formula(formula)
+        except UnsupportedTheory:
+            return None
+        if contractor is None:
+            return None
+        box = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
+        _contract_to_fixpoint(contractor, box, passes=5)
+        if box.is_empty() or box.is_unbounded():
+            return None
+        return [(box[i].lb(), box[i].ub()) for i in range(len(names))]
+
+
 def _middle_may_satisfy(contractor, box) -> bool:
     """Whether the box's middle point survives contraction: a witness the learner can
     use, rather than a box that only interval overestimation keeps alive."""
