@@ -1,6 +1,6 @@
 """Split verification measured: the kernel judging a run's formulas again with the
 interval procedure's queries whole, and split into the pieces of a cover checked by 1 and
-2 local processes (issue 26; docs/scaling.md).
+2 local processes, and by 1 and 2 Dask workers on loopback (issue 26; docs/scaling.md).
 
     python benchmarks/split_speedup.py RESULT_DIR... [--timeout 120]
 
@@ -13,7 +13,8 @@ import argparse
 import time
 from pathlib import Path
 
-from fossil_dsl.cluster.pieces import LocalPieces
+from fossil_dsl.cluster.pieces import DaskPieces, LocalPieces
+from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel import Claim, judge
 from fossil_dsl.outputs.load import load_result
 
@@ -27,12 +28,32 @@ class Timed:
         self.seconds = 0.0
         self.queries = 0
 
-    def check_all(self, formulas, names, timeout, delta=None):
+    def check_all(self, query, regions, names, timeout, delta=None):
         started = time.monotonic()
-        answers = self.inner.check_all(formulas, names, timeout, delta)
+        answers = self.inner.check_all(query, regions, names, timeout, delta)
         self.seconds += time.monotonic() - started
         self.queries += 1
         return answers
+
+
+class DaskCluster:
+    """DaskPieces on a LocalCluster of `workers` single-threaded worker processes (a
+    scheduler and workers on loopback, as on a cluster)."""
+
+    def __init__(self, workers: int):
+        from distributed import Client, LocalCluster
+        self.cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
+                                    dashboard_address=None)
+        self.client = Client(self.cluster)
+        self.inner = DaskPieces(self.client)
+        self.pieces = self.inner.pieces
+
+    def check_all(self, query, regions, names, timeout, delta=None):
+        return self.inner.check_all(query, regions, names, timeout, delta)
+
+    def close(self):
+        self.client.close()
+        self.cluster.close()
 
 
 def timed(claim, timeout: float, pieces) -> tuple[float, bool]:
@@ -48,7 +69,9 @@ def main() -> None:
     parser.add_argument("--timeout", type=float, default=120.0)
     args = parser.parse_args()
     settings = [("whole", lambda: None), ("split, 1 process", lambda: LocalPieces(1)),
-                ("split, 2 processes", lambda: LocalPieces(2))]
+                ("split, 2 processes", lambda: LocalPieces(2)),
+                ("split, 1 Dask worker", lambda: DaskCluster(1)),
+                ("split, 2 Dask workers", lambda: DaskCluster(2))]
     print("| run | setting | kernel s | of which split queries s (count) | certified |\n"
           "|---|---|---|---|---|")
     for folder in args.folders:
@@ -59,7 +82,7 @@ def main() -> None:
             local = make()
             pieces = Timed(local) if local is not None else None
             if local is not None:
-                local.check_all([], [], 1.0)  # start the processes before timing
+                local.check_all(L.TRUE, [], [], 1.0)  # start the processes before timing
             try:
                 total, certified = timed(claim, args.timeout, pieces)
             finally:

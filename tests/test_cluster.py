@@ -252,3 +252,13 @@ def test_without_dask_cluster_says_what_to_install_and_local_runs_work(tmp_path)
                           timeout=300)
     assert "codes 0 2" in done.stdout, done.stderr
     assert "pip install 'fossil_dsl[cluster]'" in done.stderr
+
+
+def test_split_verification_on_the_cluster(loopback, tmp_path, capsys):
+    """`--split --cluster`: the interval queries' pieces are checked by the workers."""
+    spec = SPECS / "literature" / "lit01_damped_pendulum.fsl"
+    code = main([str(spec), "--split", "1", "--cluster", loopback.address, "--json"])
+    data = json.loads(capsys.readouterr().out)
+    assert code == 0 and data["verdict"] == "certified"
+    procedures = [o["procedure"] for o in data["kernel"]["obligations"]]
+    assert any(p.startswith("interval, split into") for p in procedures), procedures

@@ -68,12 +68,11 @@ def test_a_bisection_covers_its_hull_and_any_gap_or_overlap_is_found(hull_sides,
 def test_the_pieces_are_the_boxes_and_the_outside_of_the_hull():
     hull = ((Fraction(-1), Fraction(1)), (Fraction(-1), Fraction(1)))
     boxes = cover.bisected(hull, 4)
-    queries = cover.pieces(TRUE_FACT, STATES, hull, boxes)
-    assert len(queries) == 5
-    outside = queries[-1]
-    inside_point = {"x": Fraction(1, 2), "y": Fraction(1, 2)}
-    assert L.truth(L.substitute(outside.args[-1], {k: E.Num(v) for k, v in inside_point.items()})) \
-        is False
+    regions = cover.regions(STATES, hull, boxes)
+    assert len(regions) == 5
+    point = {"x": E.Num(Fraction(1, 2)), "y": E.Num(Fraction(1, 2))}
+    assert [L.truth(L.substitute(r, point)) for r in regions].count(True) == 1
+    assert L.truth(L.substitute(regions[-1], point)) is False  # not outside H
 
 
 def test_the_kernel_proves_a_true_fact_from_its_pieces(checker):
@@ -94,8 +93,8 @@ class Silent:
     """A checker that answers no piece (or too few): never a proof."""
     pieces = 4
 
-    def check_all(self, formulas, names, timeout, delta=None):
-        return [Answer(Status.UNSAT)] * (len(formulas) - 1)
+    def check_all(self, query, regions, names, timeout, delta=None):
+        return [Answer(Status.UNSAT)] * (len(regions) - 1)
 
 
 def test_a_checker_that_leaves_a_piece_unanswered_proves_nothing():
@@ -121,3 +120,23 @@ def test_split_run_end_to_end(tmp_path, capsys):
     procedures = [o["procedure"] for o in data["kernel"]["obligations"]]
     assert any(p.startswith("interval, split into") for p in procedures), procedures
     assert main(["recheck", str(tmp_path)]) == 0
+
+
+def test_a_dead_piece_worker_is_replaced_and_never_proves_anything():
+    pieces = LocalPieces(1)
+    try:
+        hull = cover.hull_of(TRUE_FACT, STATES)
+        regions = cover.regions(STATES, hull, cover.bisected(hull, 2))
+        assert all(a.status is Status.UNSAT
+                   for a in pieces.check_all(TRUE_FACT, regions, STATES, 30.0))
+        worker = pieces._started[0]
+        worker.process.kill()
+        worker.process.wait()
+        # a dead worker answers UNKNOWN for what it was asked ...
+        assert worker.ask({"id": 0}).status is Status.UNKNOWN
+        # ... and the next query starts a fresh one
+        assert all(a.status is Status.UNSAT
+                   for a in pieces.check_all(TRUE_FACT, regions, STATES, 30.0))
+        assert pieces._started[0] is not worker
+    finally:
+        pieces.close()

@@ -25,9 +25,9 @@ class SplitBackend:
         boxes = cover.bisected(hull, self.pieces.pieces) if hull is not None else []
         if hull is None or cover.covers(hull, boxes):
             return self.inner.check(formula, variables, timeout, stop)
-        queries = cover.pieces(formula, names, hull, boxes)
-        answers = self.pieces.check_all(queries, names, timeout, self.delta)
-        if len(answers) != len(queries):
+        regions = cover.regions(names, hull, boxes)
+        answers = self.pieces.check_all(formula, regions, names, timeout, self.delta)
+        if len(answers) != len(regions):
             return Answer(Status.UNKNOWN, reason="a piece was not answered", solver=self.name)
         found = next((a for a in answers if a.status is Status.SAT), None)
         if found is not None:

@@ -1,8 +1,8 @@
 """Split verification: a query is unsatisfiable if each piece of a cover of the whole
 space is.
 
-The pieces are the boxes of a bisection of a hull H (any box: it need not contain the
-query's set) and one more piece, the query outside H. They are checked in parallel by
+The pieces are the query in each box of a bisection of a hull H (any box: it need not
+contain the query's set) and one more piece, the query outside H. They are checked in parallel by
 whoever the caller hands them to (local processes, Dask workers); what makes their
 UNSATs a proof is that the pieces cover every point, and that is checked here, exactly,
 rather than assumed from how they were made:
@@ -77,11 +77,10 @@ def _volume(box: Box) -> Fraction:
     return prod((hi - lo for lo, hi in box), start=Fraction(1))
 
 
-def pieces(query: L.Formula, names: Sequence[str], hull: Box,
-           boxes: Sequence[Box]) -> list[L.Formula]:
-    """The query in each box, then the query outside H."""
-    inside = [L.conjunction(query, _within(names, box)) for box in boxes]
-    return inside + [L.conjunction(query, L.negation(_within(names, hull)))]
+def regions(names: Sequence[str], hull: Box, boxes: Sequence[Box]) -> list[L.Formula]:
+    """Where the pieces are: each box, then the outside of H (a piece is the query and
+    its region)."""
+    return [_within(names, box) for box in boxes] + [L.negation(_within(names, hull))]
 
 
 def _within(names: Sequence[str], box: Box) -> L.Formula:

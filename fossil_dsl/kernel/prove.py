@@ -140,11 +140,11 @@ def _split(obligation: Obligation, states, timeout: float, delta, pieces) -> Pro
     problem = cover.covers(hull, boxes)
     if problem:
         return Proof(obligation, Outcome.NOT_PROVED, procedure, f"not a cover: {problem}")
-    queries = cover.pieces(obligation.query, names, hull, boxes)
-    answers = pieces.check_all(queries, names, timeout, delta)
-    if len(answers) != len(queries):
+    regions = cover.regions(names, hull, boxes)
+    answers = pieces.check_all(obligation.query, regions, names, timeout, delta)
+    if len(answers) != len(regions):
         return Proof(obligation, Outcome.NOT_PROVED, procedure,
-                     f"{len(answers)} answers for {len(queries)} pieces")
+                     f"{len(answers)} answers for {len(regions)} pieces")
     failed = next((a for a in answers if a.status is not Status.UNSAT), None)
     if failed is None:
         return Proof(obligation, Outcome.PROVED, procedure)

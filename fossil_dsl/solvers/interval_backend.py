@@ -36,6 +36,7 @@ class IntervalBackend:
 
     def __init__(self, delta: float = DELTA):
         self.delta = delta
+        self._compiled: dict = {}  # (query, names) -> its contractor (check_within)
 
     def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
               stop: threading.Event | None = None) -> Answer:
@@ -50,6 +51,29 @@ class IntervalBackend:
                 return _unbounded() if names else Answer(Status.SAT, {})
             start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
             split = _worth_splitting(formula, names)
+            return self._search(contractor, start, names, split, variables, deadline, stop)
+
+    def check_within(self, query: L.Formula, region: L.Formula, variables: Sequence[str],
+                     timeout: float, stop: threading.Event | None = None) -> Answer:
+        """Is `query and region` satisfiable? The query's contractor is kept for the
+        next region (the pieces of a split query share it; compiling a large query
+        costs as much as refuting a piece)."""
+        names = sorted(set(variables) | L.free_vars(query) | L.free_vars(region))
+        deadline = time.monotonic() + timeout
+        with upward_rounding() as codac:
+            key = (query, tuple(names))
+            try:
+                if key not in self._compiled:
+                    self._compiled = {key: _Compiler(codac, names).formula(query)}
+                inside = _Compiler(codac, names).formula(region)
+            except UnsupportedTheory as exc:
+                return Answer(Status.UNKNOWN, reason=str(exc))
+            parts = [c for c in (self._compiled[key], inside) if c is not None]
+            if not parts:
+                return _unbounded()
+            contractor = _combine(parts, lambda a, b: a & b)
+            start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
+            split = _worth_splitting(L.conjunction(query, region), names)
             return self._search(contractor, start, names, split, variables, deadline, stop)
 
     def _search(self, contractor, start, names, split, variables, deadline, stop) -> Answer:
