@@ -17,8 +17,9 @@ from pathlib import Path
 
 import pytest
 
-from fossil_dsl.cluster.executors import EVENTS, ClusterError, DaskExecutor, LocalExecutor
+from fossil_dsl.cluster.executors import EVENTS, DaskExecutor, LocalExecutor
 from fossil_dsl.cluster.jobs import Job, run_job
+from fossil_dsl.frontends.arguments import OptionError
 from fossil_dsl.frontends.checking import load
 from fossil_dsl.frontends.cli import main
 from fossil_dsl.frontends.portfolio import race
@@ -26,7 +27,9 @@ from fossil_dsl.frontends.portfolio import race
 pytest.importorskip("distributed")  # the [cluster] extra, which '.[test]' installs
 
 SPECS = Path(__file__).resolve().parent.parent / "specs"
-QUICK = [SPECS / "stability_continuous.fsl", SPECS / "safety_continuous.fsl"]
+# two rows of the benchmark portfolio that take a second each
+QUICK = [SPECS / "benchmarks" / "row01_stability_nonpoly2.fsl",
+         SPECS / "benchmarks" / "row16_safety_dt_two_room.fsl"]
 # a false property: its runs learn until their deadline (a job that lasts)
 LASTING = SPECS / "false" / next(p.name for p in sorted((SPECS / "false").glob("*.fsl")))
 
@@ -233,6 +236,11 @@ def test_a_malformed_address_is_refused_before_running(capsys):
         main([str(QUICK[0]), "--cluster", "not an address"])
     assert stop.value.code == 2
     assert "tcp://HOST:PORT" in capsys.readouterr().err
+
+
+def test_race_refuses_options_its_runs_cannot_carry():
+    with pytest.raises(OptionError, match="learning_rate"):
+        race(load(QUICK[0]), 2, learning_rate=0.1)
 
 
 def test_portfolio_refuses_learn_only(capsys):

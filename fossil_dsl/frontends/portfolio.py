@@ -25,6 +25,9 @@ from fossil_dsl.kernel import not_certified
 from fossil_dsl.plan.compile import compile_spec
 
 
+SENT = {"seed", "timeout", "verifier", "max_iters", "learn_only"}  # the options a job carries
+
+
 class PortfolioError(Exception):
     """No strategy left a result to read (every one crashed or was killed)."""
 
@@ -65,6 +68,10 @@ def _race(spec: CheckedSpec, count: int, executor: Executor, on_finished, option
     if options.get("learn_only"):
         raise OptionError("a portfolio races strategies to a certificate; learn_only "
                           "proves nothing (run it alone)")
+    unsent = sorted(k for k, v in options.items() if v is not None and k not in SENT)
+    if unsent:
+        raise OptionError(f"a portfolio's runs take {', '.join(sorted(SENT))} only; put "
+                          f"{', '.join(unsent)} in the spec's synthesis block instead")
     plan = compile_spec(spec, **options)  # a bad option or spec fails here, before any job
     jobs = [Job(spec.source, spec.name, seed, plan.options.timeout, options.get("verifier"),
                 keep_files=True, label=f"seed {seed}", max_iters=options.get("max_iters"))
@@ -80,7 +87,8 @@ def _race(spec: CheckedSpec, count: int, executor: Executor, on_finished, option
             f"{job.label}: {_finished(job, o).detail}" for job, o in zip(jobs, outputs)))
     with tempfile.TemporaryDirectory(prefix="fossil-portfolio-") as folder:
         result = load_result(write_files(outputs[chosen].files, Path(folder)),
-                             judge_again=winner is not None)
+                             judge_again=winner is not None,
+                             timeout=plan.options.query_timeout)
     if winner is not None and not result.certified:
         reason = f"{jobs[winner].label} reported a certificate that this machine's kernel " \
             f"does not prove: {result.reason}"
