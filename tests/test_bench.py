@@ -85,3 +85,29 @@ def test_fast_benchmarks_certify_with_one_seed(name):
     import fossil_dsl
     result = fossil_dsl.synthesise(fossil_dsl.load(BENCHMARKS / f"{name}.fsl"), seed=0)
     assert result.certified, result.reason
+
+
+class StopsAfterOne:
+    """An executor on which the user presses Ctrl-C once the first run has finished."""
+    description = "a test executor"
+
+    def run(self, jobs, on_done=lambda i, o: None, wins=lambda o: False):
+        from fossil_dsl.cluster.jobs import run_job
+        on_done(0, run_job(jobs[0]))
+        raise KeyboardInterrupt
+
+    def close(self):
+        pass
+
+
+def test_ctrl_c_keeps_the_runs_that_finished(tmp_path, monkeypatch, capsys):
+    from fossil_dsl.cluster import executors
+    from fossil_dsl.frontends.cli import main
+    monkeypatch.setattr(executors, "executor_for", lambda cluster, jobs: StopsAfterOne())
+    spec = ROOT / "specs" / "stability_continuous.fsl"
+    assert main(["bench", str(spec), "--seeds", "3", "--out", str(tmp_path)]) == 130
+    with (tmp_path / "runs.csv").open() as handle:
+        runs = list(csv.DictReader(handle))
+    assert [(r["seed"], r["outcome"]) for r in runs] == [("0", "certified")]
+    assert "Interrupted (Ctrl-C): 1 of 3 runs finished" in (tmp_path / "table.md").read_text()
+    assert "1 of 3 runs had finished" in capsys.readouterr().err

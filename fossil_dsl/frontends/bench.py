@@ -109,10 +109,19 @@ def _last_line(text: str) -> str:
     return lines[-1] if lines else ""
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep: every job was stopped; the runs that had finished."""
+
+    def __init__(self, infos: list[SpecInfo], runs: list[Run], planned: int):
+        super().__init__()
+        self.infos, self.runs, self.planned = infos, runs, planned
+
+
 def run_all(paths: Sequence[Path], seeds: int, jobs: int, verifier: str | None,
             timeout: float, progress: Callable[[Run], None] = lambda run: None,
             executor: Executor | None = None) -> tuple[list[SpecInfo], list[Run]]:
-    """Every spec × seed, on `executor` (default: `jobs` local processes)."""
+    """Every spec × seed, on `executor` (default: `jobs` local processes). On Ctrl-C
+    every job is stopped and Interrupted carries the runs that had finished."""
     infos = [describe(path, verifier) for path in paths]
     tasks = [(path, seed, info.name) for path, info in zip(paths, infos)
              for seed in range(seeds)]
@@ -124,7 +133,10 @@ def run_all(paths: Sequence[Path], seeds: int, jobs: int, verifier: str | None,
         runs[index] = run_from(output, work[index], name, path)
         progress(runs[index])
 
-    (executor or LocalExecutor(jobs)).run(work, done)
+    try:
+        (executor or LocalExecutor(jobs)).run(work, done)
+    except KeyboardInterrupt:
+        raise Interrupted(infos, [r for r in runs if r is not None], len(work)) from None
     return infos, runs
 
 
@@ -149,15 +161,18 @@ def table_rows(infos: Sequence[SpecInfo], runs: Sequence[Run]) -> list[list[str]
     return rows
 
 
-def markdown(infos, runs, command: str, where: str = "") -> str:
+def markdown(infos, runs, command: str, where: str = "", planned: int | None = None) -> str:
     rows = table_rows(infos, runs)
     machine = where or f"{platform.node() or 'this machine'} ({platform.machine()}, " \
         f"{os.cpu_count()} cores, Python {platform.python_version()})"
     lines = [f"Run on {date.today().isoformat()}, {machine}, "
              f"fossil_dsl {__version__}; command: `{command}`.",
              "Times are the runs' own (check excluded, process start-up excluded), over "
-             "successful runs only.", "",
-             "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+             "successful runs only.", ""]
+    if planned is not None and planned > len(runs):
+        lines += [f"**Interrupted (Ctrl-C): {len(runs)} of {planned} runs finished; the "
+                  "table counts those only.**", ""]
+    lines += ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |"
               for row in rows]
     retried = [r for r in runs if r.attempts > 1]
@@ -172,7 +187,8 @@ def markdown(infos, runs, command: str, where: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def write(out: Path, infos, runs, command: str, where: str = "") -> tuple[Path, Path]:
+def write(out: Path, infos, runs, command: str, where: str = "",
+          planned: int | None = None) -> tuple[Path, Path]:
     out.mkdir(parents=True, exist_ok=True)
     runs_csv = out / "runs.csv"
     with runs_csv.open("w", newline="") as handle:
@@ -181,7 +197,7 @@ def write(out: Path, infos, runs, command: str, where: str = "") -> tuple[Path, 
             writer.writeheader()
             writer.writerows(asdict(r) for r in runs)
     table = out / "table.md"
-    table.write_text(markdown(infos, runs, command, where))
+    table.write_text(markdown(infos, runs, command, where, planned))
     with (out / "table.csv").open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(COLUMNS)

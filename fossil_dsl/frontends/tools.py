@@ -9,7 +9,8 @@ from rich.progress import Progress, TextColumn
 
 from fossil_dsl.frontends import arguments
 from fossil_dsl.frontends.checking import check_text
-from fossil_dsl.frontends.console import EXIT_BAD_SPEC, EXIT_OK, consoles, report
+from fossil_dsl.frontends.console import (EXIT_BAD_SPEC, EXIT_INTERRUPTED, EXIT_OK, consoles,
+                                          report)
 from fossil_dsl.solvers.registry import BackendUnavailable
 
 
@@ -27,6 +28,7 @@ def command_bench(args: argparse.Namespace) -> int:
         err.print(f"fossilc bench: {exc}", style="red", markup=False)
         return EXIT_BAD_SPEC
     total = len(paths) * args.seeds
+    planned = None
     try:
         with Progress(*Progress.get_default_columns(), TextColumn("{task.fields[last]}"),
                       console=err, transient=True) as progress:
@@ -38,6 +40,8 @@ def command_bench(args: argparse.Namespace) -> int:
 
             infos, runs = bench.run_all(paths, args.seeds, args.jobs, args.verifier,
                                         args.timeout, advance, executor)
+    except bench.Interrupted as stop:  # every job stopped: keep what had finished
+        infos, runs, planned = stop.infos, stop.runs, stop.planned
     finally:
         executor.close()
     command = (f"fossilc bench {' '.join(args.paths)} --seeds {args.seeds} --jobs {args.jobs} "
@@ -45,9 +49,13 @@ def command_bench(args: argparse.Namespace) -> int:
                + (f" --verifier {args.verifier}" if args.verifier else "")
                + (f" --cluster {args.cluster}" if args.cluster else ""))
     where = executor.description if args.cluster else ""
-    runs_csv, table = bench.write(Path(args.out), infos, runs, command, where)
+    runs_csv, table = bench.write(Path(args.out), infos, runs, command, where, planned)
     out.print(table.read_text(), markup=False)
     out.print(f"written: {runs_csv}, {table}, {table.with_suffix('.csv')}", markup=False)
+    if planned is not None:
+        err.print(f"fossilc bench: interrupted; {len(runs)} of {planned} runs had finished",
+                  style="red", markup=False)
+        return EXIT_INTERRUPTED
     return EXIT_OK
 
 
