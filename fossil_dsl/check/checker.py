@@ -226,6 +226,10 @@ class Checker:
             if key in given and form.functions < 2:
                 self.context.warning(f"`{key}` is ignored: {form.name} uses one function "
                                      "(only SWA and RAR use two)", self.spans[f"option:{key}"])
+        if "region" in given and form.name != "region of attraction":
+            self.context.error("`region: largest` enlarges a region of attraction: it needs "
+                               f"`prove from init: stable`, not {form.name}",
+                               self.spans["option:region"])
         if "candidate" in given and "certificate" in given:
             self.context.warning("`certificate` is ignored: `candidate` gives the function "
                                  "to verify", self.spans["option:certificate"])

@@ -103,6 +103,13 @@ class OptionReader:
                       "are: " + ", ".join(names), item.span)
         return item.name
 
+    def region(self, option: ast.Option) -> str:
+        item = self.single(option)
+        if not isinstance(item, ast.Name) or item.name != "largest":
+            self.fail("`region` takes `largest` (the largest region of attraction the "
+                      "kernel proves for the learned V)", item.span)
+        return item.name
+
     def samples(self, option: ast.Option) -> SampleCounts:
         if len(option.items) == 1 and not isinstance(option.items[0], ast.NamedCount):
             return SampleCounts(default=self.count(option.items[0]))
@@ -159,4 +166,5 @@ READERS: dict[str, Callable[[OptionReader, ast.Option], object]] = {
     "learning_rate": OptionReader.positive,
     "margin": lambda reader, option: reader.positive(option, allow_zero=True),
     "delta": OptionReader.positive,
+    "region": OptionReader.region,
 }

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 from fossil_dsl.frontends.arguments import OptionError, check_options
 from fossil_dsl.frontends.build import BespokeSet, BuildError, build_spec, spec_text
@@ -9,9 +10,11 @@ from fossil_dsl.frontends.checking import (CheckResult, check_file, check_source
                                            load, loads, parse)
 from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.attempts import run_attempts
+from fossil_dsl.engine.region import largest_level
 from fossil_dsl.engine.split import SplitBackend
 from fossil_dsl.plan.compile import Plan, compile_spec
 from fossil_dsl.kernel import Verdict, judge, not_certified
+from fossil_dsl.outputs.region import region_report
 from fossil_dsl.outputs.result import Result, build_result, claim_of
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.fallback import FallbackBackend
@@ -40,8 +43,25 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
     started = time.monotonic()
     backend = None if plan.options.learn_only else _backend(plan, pieces)
     plan, outcome = run_attempts(plan, backend, progress)
-    return build_result(plan, outcome, _judge(plan, outcome, pieces),
-                        time.monotonic() - started)
+    verdict = _judge(plan, outcome, pieces)
+    found = None
+    if plan.options.largest_region and verdict.certified:
+        outcome, verdict, found = _largest(plan, outcome, verdict, pieces, started)
+    result = build_result(plan, outcome, verdict, time.monotonic() - started)
+    return replace(result, region=region_report(result, found)) if found else result
+
+
+def _largest(plan: Plan, outcome, verdict: Verdict, pieces, started: float):
+    """The outcome and verdict at the largest β the kernel proves (engine/region.py)."""
+    def judge_at(claim):
+        return judge(claim, timeout=plan.options.query_timeout, delta=plan.options.delta,
+                     pieces=pieces)
+    deadline = started + plan.options.timeout
+    found = largest_level(claim_of(plan, outcome), verdict, judge_at, deadline,
+                          plan.options.seed)
+    candidate = replace(outcome.candidate,
+                        levels={**outcome.candidate.levels, "beta": found.level})
+    return replace(outcome, candidate=candidate), found.verdict, found
 
 
 def _judge(plan: Plan, outcome, pieces=None) -> Verdict:

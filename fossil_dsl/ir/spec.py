@@ -56,6 +56,7 @@ class SynthesisOptions:
     learning_rate: Fraction | None = None
     margin: Fraction | None = None
     delta: Fraction | None = None
+    region: str | None = None  # "largest": the largest certified region of attraction
 
 
 @dataclass(frozen=True)

@@ -54,7 +54,7 @@ def load_result(directory: str | Path, judge_again: bool = True, timeout: float 
                   float(seconds.get("total", 0)), int(data.get("digits", 3)),
                   _networks(folder, plan), verdict, bool(data.get("interrupted", False)),
                   str(data.get("strategy", "learning")), claim.refutations,
-                  data.get("portfolio", {}))
+                  data.get("portfolio", {}), data.get("region", {}))
 
 
 def _plan(data: dict) -> Plan:

@@ -56,6 +56,7 @@ class Result:
     strategy: str = "learning"  # how the functions were found (not part of any proof)
     refutations: dict = field(default_factory=dict)  # obligation -> sum-of-squares evidence
     portfolio: dict = field(default_factory=dict)  # the race that found it (--portfolio)
+    region: dict = field(default_factory=dict)  # region: largest (outputs/region.py)
 
     @property
     def verdict(self) -> str:
@@ -144,6 +145,7 @@ class Result:
             "interrupted": self.interrupted,
             "strategy": self.strategy,
             **({"portfolio": self.portfolio} if self.portfolio else {}),
+            **({"region": self.region} if self.region else {}),
             "conditions": [_condition_json(c) for c in self.conditions],
             "kernel": kernel_json(self.kernel),
             "verifier": plan.verifier,

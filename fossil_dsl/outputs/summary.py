@@ -40,12 +40,29 @@ def summary_text(result: Result) -> str:
     lines.append(f"  found by: {result.strategy}")
     if result.portfolio:
         lines.append(f"  portfolio: {portfolio_line(result.portfolio)}")
+    if result.region:
+        lines.append(f"  region: {region_line(result.region)}")
     verifier = "no verifier (learn-only)" if result.learn_only else f"verifier {plan.verifier}"
     lines.append(f"  time: {result.total_seconds:.2f} s (learning {result.learn_seconds:.2f} s, "
                  f"verifying {result.verify_seconds:.2f} s), {result.iterations} iteration"
                  f"{'' if result.iterations == 1 else 's'}, {verifier}, "
                  f"seed {plan.options.seed}")
     return "\n".join(lines)
+
+
+def region_line(region: dict) -> str:
+    """`region: largest` in words (its numbers are estimates from samples)."""
+    tried = len(region["levels_tried"])
+    coverage = region["basin_coverage"]
+    basin = "no sampled point of D converges" if coverage is None else \
+        f"{100 * coverage:.1f} % of the simulated basin within D"
+    return (f"Ω = {{x in D : V(x) <= {region['level']}}}, the largest level the kernel "
+            f"proved ({tried} levels tried; V >= {region['level_upper_bound']:.4g} "
+            f"on the sampled boundary of D caps it); it covers "
+            f"{100 * region['share_of_domain']:.1f} % of D (volume {region['volume']:.3g} of "
+            f"{region['domain_volume']:.3g}) and {basin} ({region['samples']} samples; "
+            f"{region['region_points_not_converging']} sampled points of Ω do not converge "
+            "in simulation)")
 
 
 def portfolio_line(record: dict) -> str:

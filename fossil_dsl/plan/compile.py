@@ -52,6 +52,7 @@ class RunOptions:
     control_weight: float = 0.1  # of the control loss (f(x) pointing to the goal or origin)
     learn_only: bool = False  # train, measure violations on fresh samples, prove nothing
     delta: float | None = None  # precision of a delta-decision verifier (its default if None)
+    largest_region: bool = False  # enlarge β to the largest level the kernel proves
 
 
 @dataclass(frozen=True)
@@ -191,6 +192,8 @@ def _options(spec: CheckedSpec, overrides: dict) -> RunOptions:
         options = replace(options, margin=float(given.margin))
     if given.delta is not None:
         options = replace(options, delta=float(given.delta))
+    if given.region == "largest":
+        options = replace(options, largest_region=True)
     unknown = set(overrides) - set(RunOptions.__dataclass_fields__)
     if unknown:
         raise TypeError(f"unknown options: {sorted(unknown)}")
