@@ -32,6 +32,9 @@ def test_the_largest_level_is_proved_by_the_kernel_and_reported(tmp_path):
     assert json.loads((tmp_path / "result.json").read_text())["region"] == region
     again = fossil_dsl.load_result(tmp_path)  # judged afresh at the enlarged level
     assert again.certified and again.levels["beta"] == level and again.region == region
+    figure = result.plot(tmp_path / "portrait.png")
+    labels = [text.get_text() for text in figure.axes[0].get_legend().get_texts()]
+    assert any(label.startswith("certified Ω") for label in labels), labels
 
 
 @dataclass(frozen=True)

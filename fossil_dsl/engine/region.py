@@ -31,14 +31,14 @@ class LargestLevel:
     level: Fraction
     verdict: Verdict
     tried: tuple[tuple[Fraction, bool], ...]  # each candidate β and whether it was proved
-    upper: Fraction  # the smallest sampled V on ∂D
+    upper: Fraction  # the smallest sampled V on ∂D: no larger β can hold
 
 
 def largest_level(claim: Claim, verdict: Verdict, judge: Callable[[Claim], Verdict],
                   deadline: float, seed: int = 0) -> LargestLevel:
     """The largest β proved, starting from the claim's (proved) one."""
     low = claim.levels["beta"]
-    high = _upper(claim, seed)
+    high = upper = _upper(claim, seed)
     tried = []
     for _ in range(STEPS):
         if high <= low or time.monotonic() > deadline:
@@ -52,7 +52,7 @@ def largest_level(claim: Claim, verdict: Verdict, judge: Callable[[Claim], Verdi
             high = middle
         if high - low <= Fraction(1, 1000) * high:
             break
-    return LargestLevel(low, verdict, tuple(tried), high if tried else low)
+    return LargestLevel(low, verdict, tuple(tried), upper)
 
 
 def _upper(claim: Claim, seed: int) -> Fraction:

@@ -79,6 +79,8 @@ class _Portrait:
             ax.contourf(X, Y, mask, levels=[0.5, 1.5], colors=[colour], alpha=0.12)
             ax.contour(X, Y, mask, levels=[0.5], colors=[colour], linewidths=1.2)
             ax.plot([], [], color=colour, label=name)
+        if self.result.region:
+            self._draw_region(ax, grid, X, Y)
         self._draw_field(ax, pair)
         self._draw_functions(ax, grid, X, Y)
         # a map's trajectory is its iterates: points, joined by thin lines in order
@@ -95,6 +97,20 @@ class _Portrait:
             ax.set_title(f"slice {self.states[k]} = {self.centre[k]:g} "
                          "(trajectories projected)")
         ax.legend(loc="upper right", fontsize="small", framealpha=0.8)
+
+    def _draw_region(self, ax, grid, X, Y) -> None:
+        """`region: largest`: the certified Ω = {x in D : V(x) <= β}, filled."""
+        inside = self._in_region(grid).reshape(X.shape).astype(np.float64)
+        ax.contourf(X, Y, inside, levels=[0.5, 1.5], colors=["tab:purple"], alpha=0.25)
+        ax.plot([], [], color="tab:purple", alpha=0.4, linewidth=6,
+                label=f"certified Ω ({100 * self.result.region['basin_coverage']:.0f} % of "
+                "the simulated basin in D)")
+
+    def _in_region(self, points) -> np.ndarray:
+        env = state_env(self.states, points)
+        values = _column(evaluate(self.result.formulas["V"], env), len(points))
+        domain = holds(self.spec.domain.contains_formula(self.states), env, len(points))
+        return np.asarray(domain, dtype=bool) & (values <= float(self.result.levels["beta"]))
 
     def _draw_field(self, ax, pair) -> None:
         i, j = pair
@@ -160,12 +176,21 @@ class _Portrait:
     def _trajectories(self, seed: int) -> list:
         start_set = self.spec.property.role("initial") or self.spec.domain
         generator = np.random.default_rng(seed)
-        starts = sample(start_set, self.states, TRAJECTORIES, generator,
-                        (self.low, self.high))
+        starts = self._region_edge(generator) if self.result.region else \
+            sample(start_set, self.states, TRAJECTORIES, generator, (self.low, self.high))
         if self.spec.time is TimeDomain.DISCRETE:
             return _iterate(self._field_at, starts, 60, self.low, self.high)
         span = max(h - l for l, h in zip(self.low, self.high))
         return _integrate(self._field_at, starts, span, self.low, self.high)
+
+
+    def _region_edge(self, generator) -> np.ndarray:
+        """Points of Ω next to its edge (the largest V in Ω), to start trajectories."""
+        points = sample(self.spec.domain, self.states, 4000, generator, (self.low, self.high))
+        kept = points[self._in_region(points)]
+        values = _column(evaluate(self.result.formulas["V"], state_env(self.states, kept)),
+                         len(kept))
+        return kept[np.argsort(values)[-TRAJECTORIES:]]
 
 
 def _integrate(field, starts, span: float, low, high, steps: int = 600) -> list:

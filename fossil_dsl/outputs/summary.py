@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import html
 import io
+from fractions import Fraction
 
 
 def summary_text(result: Result) -> str:
@@ -53,12 +54,14 @@ def summary_text(result: Result) -> str:
 def region_line(region: dict) -> str:
     """`region: largest` in words (its numbers are estimates from samples)."""
     tried = len(region["levels_tried"])
+    refused = [float(Fraction(t["beta"])) for t in region["levels_tried"] if not t["proved"]]
+    cap = f"the smallest level not proved: {min(refused):.4g}; " if refused else ""
     coverage = region["basin_coverage"]
     basin = "no sampled point of D converges" if coverage is None else \
         f"{100 * coverage:.1f} % of the simulated basin within D"
     return (f"Ω = {{x in D : V(x) <= {region['level']}}}, the largest level the kernel "
-            f"proved ({tried} levels tried; V >= {region['level_upper_bound']:.4g} "
-            f"on the sampled boundary of D caps it); it covers "
+            f"proved ({tried} levels tried; {cap}V >= {region['level_upper_bound']:.4g} "
+            f"on the sampled boundary of D); it covers "
             f"{100 * region['share_of_domain']:.1f} % of D (volume {region['volume']:.3g} of "
             f"{region['domain_volume']:.3g}) and {basin} ({region['samples']} samples; "
             f"{region['region_points_not_converging']} sampled points of Ω do not converge "

@@ -41,7 +41,9 @@ def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta
 
 def roa_level(certificate: Certificate, name: str = "V", level: str = "beta",
               prefix: str = "") -> Level:
-    if certificate.discrete:  # the smallest Ω that holds I: the least to map into D
+    # the smallest Ω that holds I: in discrete time the least to map into D; with
+    # `region: largest` the least to prove first, before the kernel enlarges β
+    if certificate.discrete or certificate.spec.synthesis.region == "largest":
         return Level(level, name, above=None, below=f"{prefix}initial",
                      text=f"β: just over the largest {name} on I")
     return Level(level, name, above=f"{prefix}boundary", below=f"{prefix}initial",
