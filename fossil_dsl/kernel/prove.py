@@ -145,7 +145,9 @@ def _split(obligation: Obligation, states, timeout: float, delta, pieces) -> Pro
     if len(answers) != len(regions):
         return Proof(obligation, Outcome.NOT_PROVED, procedure,
                      f"{len(answers)} answers for {len(regions)} pieces")
-    failed = next((a for a in answers if a.status is not Status.UNSAT), None)
+    # a piece with a point says more than one stopped because of it
+    failed = next((a for a in answers if a.status is Status.SAT), None) or \
+        next((a for a in answers if a.status is not Status.UNSAT), None)
     if failed is None:
         return Proof(obligation, Outcome.PROVED, procedure)
     return Proof(obligation, Outcome.NOT_PROVED, procedure, _reason(failed),
