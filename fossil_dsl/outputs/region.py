@@ -28,9 +28,10 @@ def region_report(result, found) -> dict:
     in_domain = np.asarray(holds(spec.domain.contains_formula(states), env, SAMPLES), dtype=bool)
     values = np.asarray(evaluate(result.formulas["V"], env), dtype=np.float64)
     in_region = in_domain & (values <= float(found.level))
-    converges = in_domain & _converges(result, points, low, high)
+    size = float(np.max(high - low))
+    converging = in_domain & converges(result, points, near=CONVERGED * size)
     box_volume = float(np.prod(high - low))
-    basin = int(converges.sum())
+    basin = int(converging.sum())
     return {
         "method": "the largest level beta the kernel proves for V (bisection), with "
                   "every region-of-attraction obligation proved at it",
@@ -41,8 +42,8 @@ def region_report(result, found) -> dict:
         "volume": box_volume * float(in_region.mean()),
         "domain_volume": box_volume * float(in_domain.mean()),
         "simulated_basin_in_domain": basin,
-        "basin_coverage": _share((in_region & converges).sum(), basin),
-        "region_points_not_converging": int((in_region & ~converges).sum()),
+        "basin_coverage": _share((in_region & converging).sum(), basin),
+        "region_points_not_converging": int((in_region & ~converging).sum()),
         "simulation": f"{STEPS} steps of RK4 over 40 time units" if spec.time is
         TimeDomain.CONTINUOUS else f"{STEPS} iterations of the map",
     }
@@ -52,8 +53,10 @@ def _share(part, whole) -> float | None:
     return round(float(part) / float(whole), 4) if whole else None
 
 
-def _converges(result, points, low, high) -> np.ndarray:
-    """Where the closed loop's simulated trajectory ends near the origin."""
+def converges(result, points, steps: int = STEPS, horizon: float = 40.0,
+              near: float = 1e-3) -> np.ndarray:
+    """Where the closed loop's simulated trajectory ends within `near` of the origin:
+    `steps` of RK4 over `horizon` time units, or `steps` iterations of a map."""
     closed = dict(result.controller)
     field = [traversal.substitute(f, closed) for f in result.plan.spec.dynamics]
     states = result.plan.states
@@ -66,15 +69,14 @@ def _converges(result, points, low, high) -> np.ndarray:
     x = points.copy()
     with np.errstate(all="ignore"):
         if result.plan.spec.time is TimeDomain.DISCRETE:
-            for _ in range(STEPS):
+            for _ in range(steps):
                 x = step(x)
         else:
-            dt = 40.0 / STEPS
-            for _ in range(STEPS):
+            dt = horizon / steps
+            for _ in range(steps):
                 k1 = step(x)
                 k2 = step(x + dt / 2 * k1)
                 k3 = step(x + dt / 2 * k2)
                 k4 = step(x + dt * k3)
                 x = np.clip(x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4), -1e6, 1e6)
-    size = float(np.max(high - low))
-    return np.isfinite(x).all(1) & (np.linalg.norm(x, axis=1) < CONVERGED * size)
+    return np.isfinite(x).all(1) & (np.linalg.norm(x, axis=1) < near)
