@@ -14,9 +14,10 @@ import sys
 
 import numpy as np
 
-from fossil_dsl.engine.evaluate import evaluate, holds, state_env
+from fossil_dsl.engine.evaluate import holds, state_env
 from fossil_dsl.outputs.load import load_result
 from fossil_dsl.outputs.region import converges
+from fossil_dsl.outputs.simulate import in_region
 
 GRID = 300
 
@@ -30,13 +31,12 @@ def measure(folder: str) -> str:
     env = state_env(states, points)
     in_domain = np.asarray(holds(spec.domain.contains_formula(states), env, len(points)),
                            dtype=bool)
-    beta = float(result.levels["beta"])
-    in_region = in_domain & (np.asarray(evaluate(result.formulas["V"], env)) <= beta)
+    inside = in_region(result, points)
     # longer and finer than the tool's own estimate: 60 time units, step 0.005
     basin = in_domain & converges(result, points, steps=12000, horizon=60.0, near=1e-3)
     return (f"| {spec.name} | {basin.sum() / in_domain.sum():.3f} | "
-            f"{in_region.sum() / in_domain.sum():.3f} | "
-            f"{(in_region & basin).sum() / basin.sum():.3f} | {(in_region & ~basin).sum()} |")
+            f"{inside.sum() / in_domain.sum():.3f} | "
+            f"{(inside & basin).sum() / basin.sum():.3f} | {(inside & ~basin).sum()} |")
 
 
 if __name__ == "__main__":

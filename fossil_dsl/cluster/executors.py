@@ -41,7 +41,7 @@ class Executor(Protocol):
     def close(self) -> None: ...
 
 
-def _stopped(job: Job) -> JobOutput:
+def _stopped() -> JobOutput:
     return JobOutput(None, "", "", 0.0, stopped=True)
 
 
@@ -56,7 +56,7 @@ class LocalExecutor:
         stop = threading.Event()
 
         def one(job: Job) -> JobOutput:
-            return _stopped(job) if stop.is_set() else run_job(job, stop.is_set)
+            return _stopped() if stop.is_set() else run_job(job, stop.is_set)
 
         outputs: list[JobOutput | None] = [None] * len(jobs)
         pool = ThreadPoolExecutor(max_workers=self.workers)
@@ -94,14 +94,14 @@ def _worker_version() -> str:
 class DaskExecutor:
     """The workers of the Dask scheduler at `address`."""
 
-    def __init__(self, address: str, client=None):
+    def __init__(self, address: str):
         try:
             from distributed import Client
         except ImportError as exc:
             raise ClusterError("--cluster needs Dask: pip install 'fossil_dsl[cluster]' "
                                "(dask and distributed)") from exc
         try:
-            self.client = client or Client(address, timeout=CONNECT_SECONDS)
+            self.client = Client(address, timeout=CONNECT_SECONDS)
         except (OSError, TimeoutError) as exc:
             raise ClusterError(f"cannot reach the Dask scheduler at {address}: {exc}") from exc
         self._check_workers(address)
@@ -134,7 +134,7 @@ class DaskExecutor:
         try:
             for future in completed(futures):
                 i = index[future.key]
-                outputs[i] = replace(self._output(future, jobs[i]),
+                outputs[i] = replace(self._output(future),
                                      attempts=self._starts(keys[i]))
                 on_done(i, outputs[i])
                 if wins(outputs[i]):
@@ -146,9 +146,9 @@ class DaskExecutor:
         return outputs
 
     @staticmethod
-    def _output(future, job: Job) -> JobOutput:
+    def _output(future) -> JobOutput:
         if future.cancelled():
-            return _stopped(job)
+            return _stopped()
         try:
             return future.result()
         except Exception as exc:  # the job's worker died too often (KilledWorker), ...

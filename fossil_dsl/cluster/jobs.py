@@ -16,8 +16,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from fossil_dsl.version import __version__
-
 GRACE = 60.0  # s past its own deadline after which a run is killed
 POLL = 0.25  # s between looks at the run and at the stop flag
 
@@ -54,12 +52,7 @@ class JobOutput:
     stopped: bool = False  # ended because the client asked (another strategy won)
     files: dict[str, bytes] = field(default_factory=dict)  # relative path -> content
     worker: str = "local"
-    version: str = __version__  # fossil_dsl on the machine that ran it
     attempts: int = 1  # times the job was started (more: a worker was lost)
-
-    @property
-    def killed(self) -> bool:
-        return self.returncode is None and not self.stopped
 
 
 def run_job(job: Job, should_stop: Callable[[], bool] = lambda: False,

@@ -17,8 +17,7 @@ import queue
 import sys
 import threading
 
-from fossil_dsl.cluster.pieces import answer_json, check_piece
-from fossil_dsl.solvers.api import Answer, Status
+from fossil_dsl.cluster.pieces import answer_json, check_piece, stopped_answer
 
 
 class _Stops:
@@ -58,9 +57,8 @@ def main() -> None:
     threading.Thread(target=_read, args=(tasks, stops), daemon=True).start()
     while (task := tasks.get()) is not None:
         stop = stops.event(task["batch"])
-        answer = Answer(Status.UNKNOWN, reason="stopped: another piece has a point") \
-            if stop.is_set() else check_piece(task["query"], task["region"],
-                                              task["timeout"], task["delta"], stop)
+        answer = stopped_answer() if stop.is_set() else \
+            check_piece(task["query"], task["region"], task["timeout"], task["delta"], stop)
         sys.stdout.write(json.dumps({"id": task["id"], "answer": answer_json(answer)}) + "\n")
         sys.stdout.flush()
 

@@ -89,7 +89,7 @@ def answer_from(data: dict) -> Answer:
                   "interval")
 
 
-def _stopped() -> Answer:
+def stopped_answer() -> Answer:
     return Answer(Status.UNKNOWN, reason="stopped: another piece has a point")
 
 
@@ -164,7 +164,7 @@ class LocalPieces:
         waiting: queue.Queue = queue.Queue()
         for index in range(len(region_scripts)):
             waiting.put(index)
-        answers: list[Answer] = [_stopped()] * len(region_scripts)
+        answers: list[Answer] = [stopped_answer()] * len(region_scripts)
         found = threading.Event()
 
         def drive(worker: _Worker) -> None:
@@ -215,11 +215,11 @@ class DaskPieces:
                                       stop.name, pure=False)
                    for region in region_scripts]
         index = {f.key: i for i, f in enumerate(futures)}
-        answers: list[Answer] = [_stopped()] * len(futures)
+        answers: list[Answer] = [stopped_answer()] * len(futures)
         try:
             for future in completed(futures):
                 answers[index[future.key]] = future.result() if not future.cancelled() \
-                    else _stopped()
+                    else stopped_answer()
                 if answers[index[future.key]].status is Status.SAT:
                     break
         finally:

@@ -15,14 +15,45 @@ last piece, whose formula is the query and "some coordinate is outside H's inter
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from fractions import Fraction
 from math import prod
 from typing import Sequence
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
+from fossil_dsl.solvers.api import Answer, Status
 
 Box = tuple[tuple[Fraction, Fraction], ...]  # (low, high) per variable
+
+
+@dataclass(frozen=True)
+class Split:
+    pieces: int  # how many the query was cut into
+    answer: Answer  # UNSAT only if the cover checks and every piece is refuted
+
+
+def check_split(query: L.Formula, names: Sequence[str], pieces, timeout: float,
+                delta: float | None) -> Split | None:
+    """The query cut into a checked cover and its pieces checked by `pieces` (cluster/
+    pieces.py); None where the query has no bounded hull to cut (check it whole)."""
+    hull = hull_of(query, names)
+    if hull is None:
+        return None
+    boxes = bisected(hull, pieces.pieces)
+    count = len(boxes) + 1
+    problem = covers(hull, boxes)
+    if problem:
+        return Split(count, Answer(Status.UNKNOWN, reason=f"not a cover: {problem}"))
+    where = regions(names, hull, boxes)
+    answers = pieces.check_all(query, where, names, timeout, delta)
+    if len(answers) != len(where):
+        return Split(count, Answer(Status.UNKNOWN,
+                                   reason=f"{len(answers)} answers for {count} pieces"))
+    # a piece with a point says more than one stopped because of it
+    failed = next((a for a in answers if a.status is Status.SAT), None) or \
+        next((a for a in answers if a.status is not Status.UNSAT), None)
+    return Split(count, failed or Answer(Status.UNSAT))
 
 
 def hull_of(query: L.Formula, names: Sequence[str]) -> Box | None:

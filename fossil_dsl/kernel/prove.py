@@ -132,26 +132,14 @@ def _split(obligation: Obligation, states, timeout: float, delta, pieces) -> Pro
     the query has no bounded hull to split (the one search then decides)."""
     from fossil_dsl.kernel import cover
     names = [s for s in states if s in L.free_vars(obligation.query)]
-    hull = cover.hull_of(obligation.query, names)
-    if hull is None:
+    split = cover.check_split(obligation.query, names, pieces, timeout, delta)
+    if split is None:
         return None
-    boxes = cover.bisected(hull, pieces.pieces)
-    procedure = f"interval, split into {len(boxes) + 1} pieces"
-    problem = cover.covers(hull, boxes)
-    if problem:
-        return Proof(obligation, Outcome.NOT_PROVED, procedure, f"not a cover: {problem}")
-    regions = cover.regions(names, hull, boxes)
-    answers = pieces.check_all(obligation.query, regions, names, timeout, delta)
-    if len(answers) != len(regions):
-        return Proof(obligation, Outcome.NOT_PROVED, procedure,
-                     f"{len(answers)} answers for {len(regions)} pieces")
-    # a piece with a point says more than one stopped because of it
-    failed = next((a for a in answers if a.status is Status.SAT), None) or \
-        next((a for a in answers if a.status is not Status.UNSAT), None)
-    if failed is None:
+    procedure = f"interval, split into {split.pieces} pieces"
+    if split.answer.status is Status.UNSAT:
         return Proof(obligation, Outcome.PROVED, procedure)
-    return Proof(obligation, Outcome.NOT_PROVED, procedure, _reason(failed),
-                 _point(failed, states))
+    return Proof(obligation, Outcome.NOT_PROVED, procedure, _reason(split.answer),
+                 _point(split.answer, states))
 
 
 def _point(answer: Answer, states) -> tuple[Fraction, ...] | None:

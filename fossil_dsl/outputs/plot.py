@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from fossil_dsl.diagnostics import FslError
-from fossil_dsl.ir import traversal
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
 from fossil_dsl.engine.sampling import sample
+from fossil_dsl.outputs.simulate import closed_loop, column, in_region, rk4_step
 
 GRID = 200  # points per axis for sets and contours
 ARROWS = 24  # points per axis for the vector field
@@ -63,8 +63,7 @@ class _Portrait:
         self.spec = result.plan.spec
         self.states = result.plan.states
         self.low, self.high = _box(self.spec)
-        closed = {u: k for u, k in result.controller.items()}
-        self.field = [traversal.substitute(f, closed) for f in self.spec.dynamics]
+        self._field_at = closed_loop(result)
         self.centre = [_slice_value(a, b) for a, b in zip(self.low, self.high)]
         self.paths = self._trajectories(seed)
 
@@ -100,17 +99,11 @@ class _Portrait:
 
     def _draw_region(self, ax, grid, X, Y) -> None:
         """`region: largest`: the certified Ω = {x in D : V(x) <= β}, filled."""
-        inside = self._in_region(grid).reshape(X.shape).astype(np.float64)
+        inside = in_region(self.result, grid).reshape(X.shape).astype(np.float64)
         ax.contourf(X, Y, inside, levels=[0.5, 1.5], colors=["tab:purple"], alpha=0.25)
         ax.plot([], [], color="tab:purple", alpha=0.4, linewidth=6,
                 label=f"certified Ω ({100 * self.result.region['basin_coverage']:.0f} % of "
                 "the simulated basin in D)")
-
-    def _in_region(self, points) -> np.ndarray:
-        env = state_env(self.states, points)
-        values = _column(evaluate(self.result.formulas["V"], env), len(points))
-        domain = holds(self.spec.domain.contains_formula(self.states), env, len(points))
-        return np.asarray(domain, dtype=bool) & (values <= float(self.result.levels["beta"]))
 
     def _draw_field(self, ax, pair) -> None:
         i, j = pair
@@ -124,7 +117,7 @@ class _Portrait:
     def _draw_functions(self, ax, grid, X, Y) -> None:
         env = state_env(self.states, grid)
         for (name, formula), colour in zip(self.result.formulas.items(), FUNCTION_COLOURS * 4):
-            values = _column(evaluate(formula, env), len(grid)).reshape(X.shape)
+            values = column(evaluate(formula, env), len(grid)).reshape(X.shape)
             levels = self._levels_of(name)
             if not levels or not values.min() < max(levels) or not min(levels) < values.max():
                 levels = [0.0] if values.min() < 0 < values.max() else \
@@ -163,11 +156,6 @@ class _Portrait:
         grid[:, i], grid[:, j] = X.reshape(-1), Y.reshape(-1)
         return grid, X, Y
 
-    def _field_at(self, points: np.ndarray) -> np.ndarray:
-        env = state_env(self.states, points)
-        with np.errstate(all="ignore"):  # paths that blow up are cut where they leave
-            return np.stack([_column(evaluate(f, env), len(points)) for f in self.field], 1)
-
     def _sets(self) -> list[tuple[str, object]]:
         named = dict(self.spec.sets)
         return [("domain", self.spec.domain)] + [(n, s) for n, s in named.items()
@@ -183,12 +171,11 @@ class _Portrait:
         span = max(h - l for l, h in zip(self.low, self.high))
         return _integrate(self._field_at, starts, span, self.low, self.high)
 
-
     def _region_edge(self, generator) -> np.ndarray:
         """Points of Ω next to its edge (the largest V in Ω), to start trajectories."""
         points = sample(self.spec.domain, self.states, 4000, generator, (self.low, self.high))
-        kept = points[self._in_region(points)]
-        values = _column(evaluate(self.result.formulas["V"], state_env(self.states, kept)),
+        kept = points[in_region(self.result, points)]
+        values = column(evaluate(self.result.formulas["V"], state_env(self.states, kept)),
                          len(kept))
         return kept[np.argsort(values)[-TRAJECTORIES:]]
 
@@ -198,14 +185,9 @@ def _integrate(field, starts, span: float, low, high, steps: int = 600) -> list:
     speed = float(np.nan_to_num(np.linalg.norm(field(starts), axis=1)).max()) or 1.0
     dt = 4 * span / speed / steps
     points, history = starts.copy(), [starts.copy()]
-    with np.errstate(all="ignore"):
-        for _ in range(steps):
-            k1 = field(points)
-            k2 = field(points + dt / 2 * k1)
-            k3 = field(points + dt / 2 * k2)
-            k4 = field(points + dt * k3)
-            points = points + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-            history.append(points.copy())
+    for _ in range(steps):
+        points = rk4_step(field, points, dt)
+        history.append(points.copy())
     return _cut(np.stack(history, 1), low, high)
 
 
@@ -227,11 +209,6 @@ def _cut(paths: np.ndarray, low, high) -> list:
             stop = int(np.cumprod(inside.astype(np.int64)).sum())
             result.append(path[:max(stop, 1)])
     return result
-
-
-def _column(value, count: int) -> np.ndarray:
-    """A formula's value on `count` points (a constant formula gives a number)."""
-    return np.broadcast_to(np.asarray(value, dtype=np.float64), (count,)).copy()
 
 
 def _box(spec) -> tuple[list[float], list[float]]:

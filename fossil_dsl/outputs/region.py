@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from fossil_dsl.engine.evaluate import evaluate, holds, state_env
-from fossil_dsl.ir import traversal
+from fossil_dsl.engine.evaluate import holds, state_env
 from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.outputs.simulate import closed_loop, in_region, rk4_step
 
 SAMPLES = 4000  # points drawn uniformly in D's bounding box
 STEPS = 4000  # integration steps (or iterations of a map)
@@ -24,10 +24,9 @@ def region_report(result, found) -> dict:
     spec, states = result.plan.spec, result.plan.states
     low, high = (np.array([float(v) for v in side]) for side in spec.domain.bounding_box())
     points = np.random.default_rng(0).uniform(low, high, (SAMPLES, len(states)))
-    env = state_env(states, points)
-    in_domain = np.asarray(holds(spec.domain.contains_formula(states), env, SAMPLES), dtype=bool)
-    values = np.asarray(evaluate(result.formulas["V"], env), dtype=np.float64)
-    in_region = in_domain & (values <= float(found.level))
+    in_domain = np.asarray(holds(spec.domain.contains_formula(states),
+                                 state_env(states, points), SAMPLES), dtype=bool)
+    inside = in_region(result, points)
     size = float(np.max(high - low))
     converging = in_domain & converges(result, points, near=CONVERGED * size)
     box_volume = float(np.prod(high - low))
@@ -38,12 +37,12 @@ def region_report(result, found) -> dict:
         "level": str(found.level), "level_upper_bound": float(found.upper),
         "levels_tried": [{"beta": str(b), "proved": ok} for b, ok in found.tried],
         "samples": SAMPLES, "samples_in_domain": int(in_domain.sum()),
-        "share_of_domain": _share(in_region.sum(), in_domain.sum()),
-        "volume": box_volume * float(in_region.mean()),
+        "share_of_domain": _share(inside.sum(), in_domain.sum()),
+        "volume": box_volume * float(inside.mean()),
         "domain_volume": box_volume * float(in_domain.mean()),
         "simulated_basin_in_domain": basin,
-        "basin_coverage": _share((in_region & converging).sum(), basin),
-        "region_points_not_converging": int((in_region & ~converging).sum()),
+        "basin_coverage": _share((inside & converging).sum(), basin),
+        "region_points_not_converging": int((inside & ~converging).sum()),
         "simulation": f"{STEPS} steps of RK4 over 40 time units" if spec.time is
         TimeDomain.CONTINUOUS else f"{STEPS} iterations of the map",
     }
@@ -57,26 +56,9 @@ def converges(result, points, steps: int = STEPS, horizon: float = 40.0,
               near: float = 1e-3) -> np.ndarray:
     """Where the closed loop's simulated trajectory ends within `near` of the origin:
     `steps` of RK4 over `horizon` time units, or `steps` iterations of a map."""
-    closed = dict(result.controller)
-    field = [traversal.substitute(f, closed) for f in result.plan.spec.dynamics]
-    states = result.plan.states
-
-    def step(x):
-        env = state_env(states, x)
-        return np.stack([np.broadcast_to(np.asarray(evaluate(f, env), dtype=np.float64),
-                                         (len(x),)) for f in field], 1)
-
-    x = points.copy()
-    with np.errstate(all="ignore"):
-        if result.plan.spec.time is TimeDomain.DISCRETE:
-            for _ in range(steps):
-                x = step(x)
-        else:
-            dt = horizon / steps
-            for _ in range(steps):
-                k1 = step(x)
-                k2 = step(x + dt / 2 * k1)
-                k3 = step(x + dt / 2 * k2)
-                k4 = step(x + dt * k3)
-                x = np.clip(x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4), -1e6, 1e6)
+    field, x = closed_loop(result), points.copy()
+    discrete = result.plan.spec.time is TimeDomain.DISCRETE
+    for _ in range(steps):
+        x = field(x) if discrete else rk4_step(field, x, horizon / steps)
+        x = np.clip(x, -1e6, 1e6)  # a diverging path stays finite (and far)
     return np.isfinite(x).all(1) & (np.linalg.norm(x, axis=1) < near)
