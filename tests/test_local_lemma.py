@@ -95,3 +95,35 @@ def test_discrete_time_without_the_lemma_still_needs_the_image_of_the_ball():
     names = {o.name for o in list_obligations(Claim(spec, {"V": tilted},
                                                     ball_radius=Fraction(1, 100)))}
     assert "ball:image" in names and "local:positive:flat" not in names
+
+
+SHIFTED = """\
+state x0, x1
+dynamics continuous {
+    x0' = x1
+    x1' = -0.5*x1 - SIGN*(sin(x0 + pi/3) - sin(pi/3))
+}
+domain box([-0.5, -0.5], [0.5, 0.5])
+prove stable
+"""
+
+
+def test_a_hessian_with_irrational_entries_is_stated_exactly_and_proved_soundly():
+    """The change of V along x1' = ... - sin(x0 + pi/3) has cos(pi/3) in its Hessian at
+    0: the lemma states it as the closed term, and only a sound enclosure proves it."""
+    stable = SHIFTED.replace("SIGN", "1")
+    result = fossil_dsl.synthesise(fossil_dsl.loads(candidate(
+        stable, "2*x0^2 + 2*x0*x1 + 3*x1^2")), verifier="interval", timeout=120)
+    assert result.certified, result.reason
+    assert result.kernel.strengthened == "no ball left out"
+    hessian = next(p for p in result.kernel.proofs
+                   if p.obligation.name == "local:decrease:hessian")
+    assert "cos" in str(hessian.obligation.query) and hessian.proved
+    # the saddle (+ sin): the same terms, an indefinite Hessian: no lemma
+    x0, x1 = E.Var("x0"), E.Var("x1")
+    spec = fossil_dsl.loads(SHIFTED.replace("SIGN", "-1"))
+    from fossil_dsl.ir.calculus import derivative
+    V = E.add(E.power(x0, E.Num(2)), E.power(x1, E.Num(2)))
+    change = E.add(*(E.mul(derivative(V, s), f) for s, f in zip(spec.states, spec.dynamics)))
+    facts = Facts(Claim(spec, {"V": V}, ball_radius=Fraction(1, 100)))
+    assert not negative_near_origin(facts, "decrease", change, "the change of V")

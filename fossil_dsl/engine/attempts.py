@@ -5,36 +5,80 @@ tried, the kernel judges the final formulas (and checks any refutation) alone.""
 from __future__ import annotations
 
 import time
+
+import numpy as np
 from dataclasses import replace
 
-from fossil_dsl.engine import sos
+from fossil_dsl.engine import basin, sos
 from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, IterationRecord, Verdict, as_listener
 from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
-from fossil_dsl.plan.compile import Plan
+from fossil_dsl.plan.compile import Plan, origin_radius
 from fossil_dsl.solvers.api import Backend, Status
 from fossil_dsl.solvers.sos_refutation import refute
 
+BASIN_SHARE = 0.3  # of the run's time, at most, for shaping V to the basin (region: largest)
 SOS_SHARE = 0.25  # of the run's time, at most, for the sum-of-squares attempt
 SOS_SECONDS = 30.0  # and never more than this
 # per solver query on the sum-of-squares candidate, where no refutation settles a
 # condition: a candidate the solvers cannot prove at once is left to learning (bb25: an
 # interval proof of 50 s against 6 s of learning)
 SOS_QUERY_SECONDS = 5.0
+# the shaped V has no cheaper alternative in a `region: largest` run (a degree-8 decrease
+# condition near the excluded ball takes the interval procedure 5-20 s)
+BASIN_QUERY_SECONDS = 30.0
+BASIN_REFINEMENTS = 3  # programs solved again with the solvers' counterexamples
+BASIN_REFINING_SHARE = 0.1  # of the run's time, at most, for each
+BASIN_REFUTING_SECONDS = 10.0  # for sum-of-squares refutations of its obligations
 
 
 def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Plan, CegisOutcome]:
     """The plan that was run (a found function becomes its candidate) and its outcome."""
     listener = as_listener(progress)
     deadline = time.monotonic() + plan.options.timeout
-    note = ""
+    notes = []
+    if backend is not None and basin.applies(plan):
+        found, note = _shaped_to_basin(plan, backend, listener, deadline)
+        if found is not None:
+            return found
+        notes.append(note)
     if backend is not None and sos.applies(plan):
         found, note = _sum_of_squares(plan, backend, listener, deadline)
         if found is not None:
             return found
+        notes.append(note)
+    note = "; ".join(n for n in notes if n)
     outcome = Cegis(plan, backend, listener, deadline).run()
     return plan, replace(outcome, strategy="learning" + (f" ({note})" if note else ""))
+
+
+def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with V given, certified outcome) or None, what happened). Where the
+    solvers refute the V found, their counterexamples are added to its program and it is
+    solved again (up to BASIN_REFINEMENTS times)."""
+    listener.phase(0, "V shaped to the simulated basin")
+    budget = time.monotonic() + BASIN_SHARE * plan.options.timeout
+    search = basin.BasinSearch(plan)
+    finding = search.find(budget)
+    # the neighbourhood of the origin by the kernel's Taylor lemma: a polynomial of degree
+    # 8 near 0 is beyond Z3, and a numerical procedure needs the ball excluded
+    local = replace(plan, origin_radius=plan.origin_radius or origin_radius(plan.spec))
+    note = "no V shaped to the basin found"
+    for _ in range(BASIN_REFINEMENTS + 1):
+        if finding is None or time.monotonic() > deadline:
+            break
+        given, outcome = _given(local, backend, listener, deadline, finding,
+                                BASIN_QUERY_SECONDS, time.monotonic() + BASIN_REFUTING_SECONDS)
+        if outcome.certified:
+            return (given, replace(outcome, strategy=finding.describe())), ""
+        note = f"{finding.describe()}: not proved: {outcome.reason}"
+        points = [v.counterexample for v in outcome.verdicts if v.counterexample is not None]
+        if not points:
+            break
+        finding = search.refine(np.array(points, dtype=float), min(
+            deadline, time.monotonic() + BASIN_REFINING_SHARE * plan.options.timeout))
+    return None, note
 
 
 def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
@@ -45,20 +89,34 @@ def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
     finding = search(plan, time.monotonic() + budget)
     if finding is None:
         return None, "no sum-of-squares certificate found"
+    return _proved(plan, backend, listener, deadline, finding, budget)
+
+
+def _proved(plan: Plan, backend: Backend, listener, deadline: float, finding, budget: float):
+    """((plan with the function given, certified outcome) or None, what happened)."""
+    given, outcome = _given(plan, backend, listener, deadline, finding, SOS_QUERY_SECONDS,
+                            time.monotonic() + budget)
+    if not outcome.certified:
+        return None, f"{finding.describe()}: not proved: {outcome.reason}"
+    return (given, replace(outcome, strategy=finding.describe())), ""
+
+
+def _given(plan: Plan, backend: Backend, listener, deadline: float, finding,
+           query_seconds: float, refuting_until: float | None = None):
+    """The plan with the found function as its candidate, and its outcome: proved by
+    refutations of the kernel's obligations where they settle every condition, else by
+    the solvers."""
     given = replace(plan, functions=tuple(replace(f, candidate=finding.formula)
                                           for f in plan.functions))
     options = replace(plan.options, query_timeout=min(plan.options.query_timeout,
-                                                      SOS_QUERY_SECONDS))
+                                                      query_seconds))
     cegis = Cegis(replace(given, options=options), backend, listener, deadline)
     listener.phase(0, "sum-of-squares refutations")
-    outcome = _refuted(given, cegis, time.monotonic() + budget)
+    outcome = _refuted(given, cegis, refuting_until or deadline)
     listener.finished(outcome.history[-1])
     if not outcome.certified:
         outcome = _merged(cegis.run(), outcome.refutations)
-    if not outcome.certified:
-        return None, f"the sum-of-squares function of degree {finding.degree} was not proved: " \
-            f"{outcome.reason}"
-    return (given, replace(outcome, strategy=finding.describe())), ""
+    return given, outcome
 
 
 def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:

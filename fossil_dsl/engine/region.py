@@ -2,8 +2,9 @@
 the largest level β for which the kernel proves every obligation again, so that
 Ω = {x in D : V(x) <= β} is as large as this V allows.
 
-β is searched by bisection between the proved level and the smallest sampled value of V
-on the boundary of D (no larger β can satisfy V > β there). Each candidate is judged by
+β is searched between the proved level and the smallest sampled value of V on the
+boundary of D (no larger β can satisfy V > β there): first just under that upper end
+(enough if proved), then by bisection. Each candidate is judged by
 the kernel from scratch (the `judge` the caller passes); the answer is the last β it
 certified, with that verdict. Nothing here proves anything.
 """
@@ -22,6 +23,7 @@ from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.kernel import Claim, Verdict
 
 STEPS = 8  # bisection steps at most
+NEAR_TOP = Fraction(99, 100)  # of the upper end: tried first, and enough if proved
 SAMPLES = 4000  # points of ∂D for the upper end
 DIGITS = 4  # significant digits of a candidate β (short rationals, quick queries)
 
@@ -40,17 +42,18 @@ def largest_level(claim: Claim, verdict: Verdict, judge: Callable[[Claim], Verdi
     low = claim.levels["beta"]
     high = upper = _upper(claim, seed)
     tried = []
-    for _ in range(STEPS):
+    for step in range(STEPS + 1):
         if high <= low or time.monotonic() > deadline:
             break
-        middle = _short((low + high) / 2, low, high)
+        # a V shaped to the basin is often proved just under the upper end: one try there
+        middle = _short(NEAR_TOP * high if step == 0 else (low + high) / 2, low, high)
         judged = judge(replace(claim, levels={**claim.levels, "beta": middle}))
         tried.append((middle, judged.certified))
         if judged.certified:
             low, verdict = middle, judged
         else:
             high = middle
-        if high - low <= Fraction(1, 1000) * high:
+        if high - low <= Fraction(1, 1000) * high or (step == 0 and judged.certified):
             break
     return LargestLevel(low, verdict, tuple(tried), upper)
 

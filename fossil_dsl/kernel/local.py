@@ -60,22 +60,28 @@ def _at_origin(g: E.Expr, states) -> list[E.Expr]:
     return [traversal.substitute(e, origin) for e in (g, *(derivative(g, s) for s in states))]
 
 
-def _hessian_at_origin(g: E.Expr, states) -> list[list[Fraction]] | None:
+def _hessian_at_origin(g: E.Expr, states) -> list[list[E.Expr]] | None:
+    """H's entries: numbers, or closed terms with a finite enclosure (cos(pi/3) where
+    the field has sin(x + pi/3): the obligation on H states them exactly, and only a
+    procedure that encloses them soundly can prove it)."""
     origin = {s: E.ZERO for s in states}
     rows = []
     for a in states:
         first = derivative(g, a)
         row = [traversal.substitute(derivative(first, b), origin) for b in states]
-        if not all(isinstance(v, E.Num) for v in row):
-            return None  # not an exact number at 0: the quadratic form is not decidable
-        rows.append([v.value for v in row])
+        for entry in row:
+            low, high = enclose(entry)  # raises on a state left in it
+            if not (math.isfinite(low) and math.isfinite(high) and low <= high):
+                return None
+        rows.append(row)
     return rows
 
 
 def _margin(hessian) -> Fraction | None:
     """μ > 0 with H/2 + μ I negative definite (numerically; the obligation decides)."""
     import numpy as np
-    largest = float(np.linalg.eigvalsh(np.array(hessian, dtype=float) / 2).max())
+    middle = [[sum(enclose(entry)) / 2 for entry in row] for row in hessian]
+    largest = float(np.linalg.eigvalsh(np.array(middle, dtype=float) / 2).max())
     if not largest < 0:
         return None
     return Fraction(-largest * float(MU_SHARE)).limit_denominator(10 ** 6) or None
@@ -113,7 +119,7 @@ def _obligations(facts: Facts, name, words, at_zero, hessian, mu, thirds, bound)
         L.disjunction(*(L.disjunction(L.Compare("<", v, E.ZERO), L.Compare(">", v, E.ZERO))
                         for v in at_zero))))
     x = [E.Var(s) for s in states]
-    form = E.add(*(E.mul(E.Num(hessian[i][j] / 2), x[i], x[j])
+    form = E.add(*(E.mul(E.Num(Fraction(1, 2)), hessian[i][j], x[i], x[j])
                    for i in range(n) for j in range(n)),
                  E.mul(E.Num(mu), facts.squared_norm()))
     # both sides are quadratic forms: on the shell 1/4 <= |x|^2 <= 1 is for every x, and

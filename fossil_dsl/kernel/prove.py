@@ -26,8 +26,10 @@ from enum import Enum
 from fractions import Fraction
 from typing import Sequence
 
-from fossil_dsl.ir import traversal
+from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir import traversal
 from fossil_dsl.kernel.obligations import Obligation
 from fossil_dsl.solvers.positivstellensatz import BEFORE_Z3_FROM, refutation_problem
 from fossil_dsl.solvers.api import Answer, Status
@@ -63,6 +65,8 @@ GIVEN_REFUTATION = "the refutation handed over with the claim"  # (not one found
 # Shares of an arithmetic obligation's time: Z3, a sum-of-squares refutation (checked
 # exactly; for conjunctions of polynomial comparisons), the interval procedure, CVC5.
 SHARES = {"z3": 0.3, SUM_OF_SQUARES: 0.1, "interval": 0.4, "cvc5": 0.2}
+INTERVAL_FIRST_DEGREE = 7  # from this degree on, the interval procedure goes before Z3
+INTERVAL_FIRST_STATES = 3  # (in up to this many states, where bisection is quick)
 
 
 def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
@@ -86,7 +90,11 @@ def discharge(obligation: Obligation, states: Sequence[str], timeout: float,
 def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str,
                 pieces) -> Proof:
     early = len(states) >= BEFORE_Z3_FROM  # the refutation before Z3
+    # Z3 stalls for its whole share on polynomials of high degree (a degree-8 V shaped
+    # to a basin: 18 s per condition) where the interval procedure answers in seconds
+    high = _degree(obligation.query, states) >= INTERVAL_FIRST_DEGREE
     order = sorted(SHARES, key=lambda name: (name != first,
+                                             not (high and name == "interval"),
                                              not (early and name == SUM_OF_SQUARES)))
     reasons = []
     for name in order:
@@ -105,6 +113,21 @@ def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: st
                          _point(answer, states))
         reasons.append(f"{name}: {_reason(answer)}")
     return Proof(obligation, Outcome.NOT_PROVED, ", ".join(order), "; ".join(reasons))
+
+
+def _degree(query: L.Formula, states) -> int:
+    """The largest degree of a polynomial side of the query's comparisons (0 if none is
+    a polynomial of few states)."""
+    if len(states) > INTERVAL_FIRST_STATES:
+        return 0
+    degrees = [0]
+    for comparison in L.comparisons(query):
+        for side in (comparison.left, comparison.right):
+            try:
+                degrees.append(P.degree(P.polynomial(side, states)))
+            except (P.NotPolynomial, E.ExprError, ValueError, ZeroDivisionError):
+                continue
+    return max(degrees)
 
 
 def _solver(name: str):

@@ -3,35 +3,19 @@ anything): its field, or its map, on a batch of points; a step of RK4; and which
 lie in a certified region {x in D : V(x) <= β}."""
 from __future__ import annotations
 
-from typing import Callable
-
 import numpy as np
 
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
+from fossil_dsl.engine.trajectories import Field, column, numeric_field, rk4_step
 from fossil_dsl.ir import traversal
 
-Field = Callable[[np.ndarray], np.ndarray]
+__all__ = ["Field", "closed_loop", "column", "in_region", "rk4_step"]
 
 
 def closed_loop(result) -> Field:
     """The dynamics with the proved controller substituted, on points of shape [N, n]."""
     field = [traversal.substitute(f, dict(result.controller)) for f in result.plan.spec.dynamics]
-    states = result.plan.states
-
-    def at(points: np.ndarray) -> np.ndarray:
-        env = state_env(states, points)
-        with np.errstate(all="ignore"):  # paths that blow up are cut or counted as such
-            return np.stack([column(evaluate(f, env), len(points)) for f in field], 1)
-    return at
-
-
-def rk4_step(field: Field, points: np.ndarray, dt: float) -> np.ndarray:
-    with np.errstate(all="ignore"):
-        k1 = field(points)
-        k2 = field(points + dt / 2 * k1)
-        k3 = field(points + dt / 2 * k2)
-        k4 = field(points + dt * k3)
-        return points + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return numeric_field(field, result.plan.states)
 
 
 def in_region(result, points: np.ndarray) -> np.ndarray:
@@ -41,8 +25,3 @@ def in_region(result, points: np.ndarray) -> np.ndarray:
     values = column(evaluate(result.formulas["V"], env), len(points))
     domain = holds(result.plan.spec.domain.contains_formula(states), env, len(points))
     return np.asarray(domain, dtype=bool) & (values <= float(result.levels["beta"]))
-
-
-def column(value, count: int) -> np.ndarray:
-    """A formula's value on `count` points (a constant formula gives a number)."""
-    return np.broadcast_to(np.asarray(value, dtype=np.float64), (count,)).copy()

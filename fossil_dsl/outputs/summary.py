@@ -60,7 +60,8 @@ def region_line(region: dict) -> str:
     basin = "no sampled point of D converges" if coverage is None else \
         f"{100 * coverage:.1f} % of the simulated basin within D"
     return (f"Ω = {{x in D : V(x) <= {region['level']}}}, the largest level the kernel "
-            f"proved ({tried} levels tried; {cap}V >= {region['level_upper_bound']:.4g} "
+            f"proved ({tried} level{'s' if tried != 1 else ''} tried; {cap}V >= "
+            f"{region['level_upper_bound']:.4g} "
             f"on the sampled boundary of D); it covers "
             f"{100 * region['share_of_domain']:.1f} % of D (volume {region['volume']:.3g} of "
             f"{region['domain_volume']:.3g}) and {basin} ({region['samples']} samples; "
