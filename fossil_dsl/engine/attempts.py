@@ -28,6 +28,7 @@ SOS_QUERY_SECONDS = 5.0
 # the shaped V has no cheaper alternative in a `region: largest` run (a degree-8 decrease
 # condition near the excluded ball takes the interval procedure 5-20 s)
 BASIN_QUERY_SECONDS = 30.0
+BASIN_TOTAL_SHARE = 0.5  # of the run's time, at most, for the whole attempt
 BASIN_REFINEMENTS = 3  # programs solved again with the solvers' counterexamples
 BASIN_REFINING_SHARE = 0.1  # of the run's time, at most, for each
 BASIN_REFUTING_SECONDS = 10.0  # for sum-of-squares refutations of its obligations
@@ -58,7 +59,11 @@ def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
     solvers refute the V found, their counterexamples are added to its program and it is
     solved again (up to BASIN_REFINEMENTS times)."""
     listener.phase(0, "V shaped to the simulated basin")
-    budget = time.monotonic() + BASIN_SHARE * plan.options.timeout
+    started = time.monotonic()
+    budget = started + BASIN_SHARE * plan.options.timeout
+    # the whole attempt, proofs and refinements included: the rest of the run (sum of
+    # squares, learning, raising β) keeps the other half
+    deadline = min(deadline, started + BASIN_TOTAL_SHARE * plan.options.timeout)
     search = basin.BasinSearch(plan)
     finding = search.find(budget)
     # the neighbourhood of the origin by the kernel's Taylor lemma: a polynomial of degree

@@ -44,6 +44,8 @@ from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan
 
 DEGREES = (6, 8)  # of V, tried in turn; the one covering more of the sampled basin wins
+# from 3 states on (a degree-6 program in 3 states took 20 s a round): lower degrees
+DEGREES_MANY = (4, 6)
 ENOUGH = 0.97  # a degree covering this share of the sampled basin is not raised
 SAMPLES = 6000  # points of D's box, simulated
 NEAR_ORIGIN = 1500  # more, at log-uniform radii, where the local shape is decided
@@ -68,7 +70,8 @@ class BasinFinding:
 
     def describe(self) -> str:
         return (f"V of degree {self.degree} shaped to the simulated basin (conic program, "
-                f"{self.rounds} rounds; {100 * self.coverage:.1f} % of the sampled basin "
+                f"{self.rounds} round{'s' if self.rounds != 1 else ''}; "
+                f"{100 * self.coverage:.1f} % of the sampled basin "
                 f"below level 1), {self.seconds:.2f} s")
 
 
@@ -98,7 +101,7 @@ class BasinSearch:
     def find(self, deadline: float) -> BasinFinding | None:
         """The best V by the coverage its program reports (the first degree that covers
         ENOUGH: a lower degree is quicker to prove), or None."""
-        for degree in DEGREES:
+        for degree in DEGREES if len(self.samples.states) < 3 else DEGREES_MANY:
             if time.monotonic() > deadline:
                 break
             program = _Program(self.samples, degree)
@@ -240,7 +243,7 @@ class _Program:
         for round_ in range(1, ROUNDS + 1):
             if time.monotonic() > deadline:
                 break
-            solved = solve_conic(self, s.basin, self.outside, self.decrease)
+            solved = solve_conic(self, s.basin, self.outside, self.decrease, deadline)
             if solved is None:
                 break
             c, slack = solved

@@ -7,6 +7,7 @@ V's quadratic part Q: Q >= e I and -(A^T Q + Q A) >= e I. The program object sup
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -17,7 +18,7 @@ LOCAL_EPS = 2e-2
 DECREASE_WEIGHT = 100.0  # of a decrease slack against the coverage objective
 
 
-def solve_conic(program, basin, outside, decrease):
+def solve_conic(program, basin, outside, decrease, deadline: float):
     """(c, decrease slacks) or None, from Clarabel: variables c, hinge h >= V - 1 on the
     basin, slack t >= dV/dt + eps|y|^2 on the decrease points."""
     import clarabel
@@ -48,6 +49,7 @@ def solve_conic(program, basin, outside, decrease):
                                 np.full(nd, DECREASE_WEIGHT / max(nd, 1))])
     settings = clarabel.DefaultSettings()
     settings.verbose = False
+    settings.time_limit = max(0.1, deadline - time.monotonic())
     solution = clarabel.DefaultSolver(sparse.csc_matrix((len(objective),) * 2), objective, A,
                                       right, cones, settings).solve()
     if str(solution.status) not in ("Solved", "AlmostSolved"):

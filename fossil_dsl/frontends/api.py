@@ -53,10 +53,14 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
 
 def _largest(plan: Plan, outcome, verdict: Verdict, pieces, started: float):
     """The outcome and verdict at the largest β the kernel proves (engine/region.py)."""
-    def judge_at(claim):
-        return judge(claim, timeout=plan.options.query_timeout, delta=plan.options.delta,
-                     pieces=pieces)
     deadline = started + plan.options.timeout
+
+    def judge_at(claim):
+        # each obligation gets at most what is left of the run (a level judged past the
+        # deadline overran a 120 s run by 15 s)
+        left = max(1.0, deadline - time.monotonic())
+        return judge(claim, timeout=min(plan.options.query_timeout, left),
+                     delta=plan.options.delta, pieces=pieces)
     found = largest_level(claim_of(plan, outcome), verdict, judge_at, deadline,
                           plan.options.seed)
     candidate = replace(outcome.candidate,
