@@ -3,5 +3,5 @@
 (set-logic QF_NRA)
 (declare-const x0 Real)
 (declare-const x1 Real)
-(assert (<= (/ 8721.0 10000.0) 0.0))
+(assert (<= (/ 4971.0 5000.0) 0.0))
 (check-sat)
