@@ -33,12 +33,11 @@ from fractions import Fraction
 import numpy as np
 
 from fossil_dsl.engine.basin_program import EPS, solve_conic
-from fossil_dsl.engine.evaluate import evaluate, holds, state_env
+from fossil_dsl.engine.evaluate import holds, state_env
 from fossil_dsl.engine.sampling import sample
-from fossil_dsl.engine.trajectories import column, numeric_field, rk4_step
+from fossil_dsl.engine.trajectories import numeric_field, rk4_step
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
-from fossil_dsl.ir.calculus import derivative
 from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan
@@ -276,13 +275,7 @@ class _Program:
 
 
 def _jacobian(plan: Plan) -> np.ndarray | None:
-    """df/dx at the origin, or None where it is not a finite number."""
-    spec = plan.spec
-    zero = state_env(spec.states, np.zeros((1, len(spec.states))))
-    try:
-        rows = [[float(column(evaluate(derivative(f, v), zero), 1)[0]) for v in spec.states]
-                for f in spec.dynamics]
-    except (E.ExprError, ValueError, ZeroDivisionError, TypeError):
-        return None
-    matrix = np.array(rows)
-    return matrix if np.all(np.isfinite(matrix)) else None
+    """df/dx at the origin (engine/linear.py), or None where it is not a finite number."""
+    from fossil_dsl.engine.linear import jacobians  # imports torch: only when it applies
+    found = jacobians(plan.spec)
+    return None if found is None else found[0]
