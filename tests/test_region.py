@@ -7,9 +7,12 @@ from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
+import numpy as np
+
 import fossil_dsl
+from fossil_dsl.engine.evaluate import evaluate
 from fossil_dsl.engine.region import largest_level
-from fossil_dsl.kernel import Claim
+from fossil_dsl.kernel import Claim, judge, list_obligations
 
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "specs" / "roa_largest.fsl"
@@ -78,10 +81,85 @@ def _quadratic():
 
 
 def test_region_is_only_for_a_region_of_attraction():
-    text = SPEC.read_text().replace("prove from init: stable", "prove stable")
-    checked = fossil_dsl.check_text(text, "stable.fsl")
+    text = SPEC.read_text().replace("prove from init: stable",
+                                    "set bad = ball([2, 0], 0.2)\nprove from init: always not bad")
+    checked = fossil_dsl.check_text(text, "safety.fsl")
     assert not checked.ok
     assert "`region: largest` enlarges a region of attraction" in checked.render()
-    assert "stable.fsl:13:13" in checked.render()
+    assert "`prove stable` or `prove from init: stable`" in checked.render()
+    assert "safety.fsl:14:13" in checked.render()
     wrong = fossil_dsl.check_text(SPEC.read_text().replace("largest", "huge"), "huge.fsl")
     assert "`region` takes `largest`" in wrong.render() and "huge.fsl:13:21" in wrong.render()
+
+
+NO_INITIAL = ROOT / "specs" / "stable_largest.fsl"
+VDP_NO_INITIAL = SPEC.read_text().replace("prove from init: stable", "prove stable")
+
+
+def test_stable_with_largest_region_has_no_initial_set_in_its_rule():
+    spec = fossil_dsl.check_text(VDP_NO_INITIAL, "vdp.fsl").spec
+    assert spec.property.form == "largest region of attraction"
+    names = {o.name for o in list_obligations(_vdp_claim(spec, Fraction(1, 2)))}
+    assert {"condition:boundary", "condition:positive", "condition:decrease",
+            "level:beta"} <= names
+    assert not any("initial" in name for name in names)
+    discrete = fossil_dsl.check_text(DISCRETE_NO_INITIAL, "map.fsl").spec
+    names = {o.name for o in list_obligations(Claim(discrete, {"V": _quadratic()}, {},
+                                                    {"beta": Fraction(1, 2)}))}
+    assert "condition:image" in names and "condition:boundary" not in names
+
+
+def test_the_kernel_grants_a_level_only_inside_the_basin():
+    """V from the linearisation's Lyapunov equation: a small level is proved; a level
+    whose set reaches past the limit cycle (where V cannot decrease) is refused."""
+    spec = fossil_dsl.check_text(VDP_NO_INITIAL, "vdp.fsl").spec
+    small = judge(_vdp_claim(spec, Fraction(1, 2)))
+    assert small.certified and "asymptotically stable" in small.guarantee
+    assert "from I" not in small.guarantee
+    assert not judge(_vdp_claim(spec, Fraction(7))).certified
+
+
+def test_an_unstable_origin_is_not_certified_with_a_region():
+    text = VDP_NO_INITIAL.replace("x0 - (1 - x0^2)*x1", "x0 + x1")
+    spec = fossil_dsl.check_text(text, "saddle.fsl").spec
+    assert not judge(_vdp_claim(spec, Fraction(1, 100))).certified
+    result = fossil_dsl.synthesise(spec, timeout=20)
+    assert not result.certified
+
+
+def test_the_largest_region_without_an_initial_set_end_to_end(tmp_path):
+    """A system the engine was not tuned to: the basin is the strip |x| < 1."""
+    result = fossil_dsl.synthesise(fossil_dsl.load(NO_INITIAL))
+    assert result.certified and result.region
+    guarantee = result.guarantee()
+    assert "asymptotically stable" in guarantee and "ε" not in guarantee
+    assert "shaped to the simulated basin" in result.strategy
+    assert result.region["basin_coverage"] >= 0.9
+    assert result.region["region_points_not_converging"] == 0
+    # every point of the certified region has |x| < 1 (the basin), on a dense grid
+    V = result.formulas["V"]
+    level = float(result.levels["beta"])
+    grid = np.linspace(-2, 2, 201)
+    xs, ys = np.meshgrid(grid, grid)
+    values = evaluate(V, {"x": xs, "y": ys})
+    assert np.all(np.abs(xs[values <= level]) < 1)
+
+
+DISCRETE_NO_INITIAL = """\
+state x0, x1
+dynamics discrete {
+    next(x0) = 0.5*x0 + 0.1*x1^2
+    next(x1) = 0.5*x1
+}
+domain box([-1, -1], [1, 1])
+prove stable
+synthesis { region: largest }
+"""
+
+
+def _vdp_claim(spec, beta):
+    from fossil_dsl.ir import expr as E
+    x0, x1 = E.Var("x0"), E.Var("x1")
+    # A^T P + P A = -I for A = [[0, -1], [1, -1]]: P = [[3/2, -1/2], [-1/2, 1]]
+    V = E.add(E.mul(E.Num(Fraction(3, 2)), x0, x0), E.neg(E.mul(x0, x1)), E.mul(x1, x1))
+    return Claim(spec, {"V": V}, {}, {"beta": beta})

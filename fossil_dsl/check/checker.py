@@ -10,7 +10,8 @@ from typing import Sequence
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
 from fossil_dsl.check.options import OptionReader
-from fossil_dsl.check.properties import PropertyChecker, PropertyForm, formula_set_names
+from fossil_dsl.check.properties import (LARGEST_REGION, PropertyChecker, PropertyForm,
+                                         formula_set_names)
 from fossil_dsl.check.relations import RelationProver, Subject, check_equilibrium
 from fossil_dsl.check.sets import SetChecker, set_reference_names
 from fossil_dsl.diagnostics import Diagnostic, Span, article, has_errors
@@ -74,6 +75,9 @@ class Checker:
             return None
         prop, form = checked
         options = self.check_option_use(options, given, form)
+        if options.region == "largest" and form.name == "stability":
+            form = LARGEST_REGION
+            prop = replace(prop, form=form.name, certificate=form.certificate)
         self.prove_facts(form, prop, domain, dynamics, equation_spans, time)
         self.warn_unused()
         if has_errors(self.context.diagnostics):
@@ -226,9 +230,9 @@ class Checker:
             if key in given and form.functions < 2:
                 self.context.warning(f"`{key}` is ignored: {form.name} uses one function "
                                      "(only SWA and RAR use two)", self.spans[f"option:{key}"])
-        if "region" in given and form.name != "region of attraction":
+        if "region" in given and form.name not in ("region of attraction", "stability"):
             self.context.error("`region: largest` enlarges a region of attraction: it needs "
-                               f"`prove from init: stable`, not {form.name}",
+                               f"`prove stable` or `prove from init: stable`, not {form.name}",
                                self.spans["option:region"])
         if "candidate" in given and "certificate" in given:
             self.context.warning("`certificate` is ignored: `candidate` gives the function "

@@ -74,6 +74,12 @@ FORMS: list[PropertyForm] = [
 ]
 
 
+# `prove stable` with `region: largest` (chosen by the options, never matched): the
+# region Ω itself is the result, so there is no initial set
+LARGEST_REGION = PropertyForm("largest region of attraction", "ROA", "stable",
+                              needs_initial=False, stable_type=True)
+
+
 def register_form(form: PropertyForm) -> None:
     """Add a property form (for user-defined certificates), replacing one of the same
     name; later forms win ties."""

@@ -14,6 +14,7 @@ from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, IterationRecord, Verdict, as_listener
 from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
+from fossil_dsl.kernel.rules import lemma_radius
 from fossil_dsl.plan.compile import Plan, origin_radius
 from fossil_dsl.solvers.api import Backend, Status
 from fossil_dsl.solvers.sos_refutation import refute
@@ -66,15 +67,13 @@ def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
     deadline = min(deadline, started + BASIN_TOTAL_SHARE * plan.options.timeout)
     search = basin.BasinSearch(plan)
     finding = search.find(budget)
-    # the neighbourhood of the origin by the kernel's Taylor lemma: a polynomial of degree
-    # 8 near 0 is beyond Z3, and a numerical procedure needs the ball excluded
-    local = replace(plan, origin_radius=plan.origin_radius or origin_radius(plan.spec))
     note = "no V shaped to the basin found"
     for _ in range(BASIN_REFINEMENTS + 1):
         if finding is None or time.monotonic() > deadline:
             break
-        given, outcome = _given(local, backend, listener, deadline, finding,
-                                BASIN_QUERY_SECONDS, time.monotonic() + BASIN_REFUTING_SECONDS)
+        given, outcome = _given(_ball_left_out(plan, finding), backend, listener, deadline,
+                                finding, BASIN_QUERY_SECONDS,
+                                time.monotonic() + BASIN_REFUTING_SECONDS)
         if outcome.certified:
             return (given, replace(outcome, strategy=finding.describe())), ""
         note = f"{finding.describe()}: not proved: {outcome.reason}"
@@ -84,6 +83,17 @@ def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
         finding = search.refine(np.array(points, dtype=float), min(
             deadline, time.monotonic() + BASIN_REFINING_SHARE * plan.options.timeout))
     return None, note
+
+
+def _ball_left_out(plan: Plan, finding) -> Plan:
+    """The plan with the ball round the origin that the conditions leave out: the
+    neighbourhood of the origin goes to the kernel's Taylor lemma (a polynomial of degree
+    8 near 0 is beyond Z3, and a numerical procedure needs the ball excluded), so the
+    ball is made small enough for the lemma's estimates where halving it helps (a
+    quadratic part nearly flat in one direction needs a smaller ball)."""
+    radius = plan.origin_radius or origin_radius(plan.spec)
+    claim = Claim(plan.spec, {plan.functions[0].name: finding.formula}, {}, {}, radius)
+    return replace(plan, origin_radius=lemma_radius(claim) or radius)
 
 
 def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):

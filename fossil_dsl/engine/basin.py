@@ -41,6 +41,7 @@ from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan
+from fossil_dsl.plan.certificates.roa import ROA_FORMS
 
 DEGREES = (6, 8)  # of V, tried in turn; the one covering more of the sampled basin wins
 # from 3 states on (a degree-6 program in 3 states took 20 s a round): lower degrees
@@ -76,7 +77,7 @@ class BasinFinding:
 
 def applies(plan: Plan) -> bool:
     spec = plan.spec
-    return (plan.options.largest_region and plan.certificate.form == "region of attraction"
+    return (plan.options.largest_region and plan.certificate.form in ROA_FORMS
             and spec.time is TimeDomain.CONTINUOUS and not spec.inputs
             and plan.controller is None and spec.torch_dynamics is None
             and spec.synthesis.certificate is None and spec.synthesis.candidate is None

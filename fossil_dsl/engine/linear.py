@@ -23,8 +23,9 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.ir.calculus import derivative
 from fossil_dsl.ir.enclosure import enclose
 from fossil_dsl.ir.spec import CheckedSpec, TimeDomain
+from fossil_dsl.plan.certificates.roa import ROA_FORMS
 
-STABLE_FORMS = ("stability", "region of attraction", "stable while avoid")
+STABLE_FORMS = ("stability", "stable while avoid") + ROA_FORMS
 # where between the largest x^T P x on I and the smallest on U (sampled) the barrier's
 # zero level goes: low, since the quadratic's decrease is surest near the origin
 LEVEL_POSITION = 0.25

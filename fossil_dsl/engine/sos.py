@@ -28,8 +28,9 @@ from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
 from fossil_dsl.plan.compile import Plan
+from fossil_dsl.plan.certificates.roa import ROA_FORMS
 
-FORMS = ("stability", "region of attraction")  # whose conditions a Lyapunov V meets on D
+FORMS = ("stability",) + ROA_FORMS  # whose conditions a Lyapunov V meets on D
 DEGREES = (1, 2)  # V of degree 2, then 4 (z of degree up to d)
 V_FLOOR = Fraction(1, 1000)  # e in V = z^T P z + e|x|^2: V >= e|x|^2
 DECIMALS = 6  # kept of P's entries (trace P = 1: entries are at most 1)
@@ -80,7 +81,7 @@ def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is None or x[program.margin] <= MIN_MARGIN:
             continue
-        if plan.certificate.form == "region of attraction":
+        if plan.certificate.form in ROA_FORMS:
             rounder = _roundest(program, float(x[program.margin]), deadline)
             x = rounder if rounder is not None else x
         formula = P.to_expr(program.exact_v(x), plan.states)

@@ -5,12 +5,15 @@ by `Facts.never` itself.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+from fractions import Fraction
+
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.kernel.local import negative_near_origin
-from fossil_dsl.kernel.obligations import (BALL_ROOM, GAMMA, Facts, Obligation, rule,
+from fossil_dsl.kernel.obligations import (BALL_ROOM, GAMMA, Claim, Facts, Obligation, rule,
                                            strengthening)
 
 CONTINUOUS, DISCRETE = TimeDomain.CONTINUOUS, TimeDomain.DISCRETE
@@ -93,6 +96,19 @@ def no_ball_left_out(facts: Facts) -> bool:
         and negative_near_origin(facts, "decrease", facts.change("V"), "the change of V")
 
 
+def lemma_radius(claim: Claim, halvings: int = 4) -> Fraction | None:
+    """The largest of r, r/2, ..., r/2^halvings (r: the claim's excluded ball) at which
+    the Taylor lemma's own choices of μ and M pass for V and its change, so that its
+    obligations can cover the ball; None if at none. A choice for the engine, not a
+    proof: the lemma's obligations still decide."""
+    radius = claim.ball_radius
+    for _ in range(halvings + 1):
+        if radius > 0 and no_ball_left_out(Facts(replace(claim, ball_radius=radius))):
+            return radius
+        radius /= 2
+    return None
+
+
 ROA_GUARANTEE = (
     "every trajectory from I stays in Ω = {x in D : V(x) <= β} and converges to the "
     "origin: V <= β on I and V > β on the boundary of D, so Ω cannot be left, and V is "
@@ -126,29 +142,55 @@ strengthening("stability", CONTINUOUS, name="no ball left out",
               guarantee=stability_guarantee)(no_ball_left_out)
 
 
-def region_of_attraction(facts: Facts) -> None:
+def stable_sublevel_set(facts: Facts) -> None:
+    """Ω = {x in D : V(x) <= β} cannot be left, and V is a strict Lyapunov function on
+    it: every trajectory from Ω converges to the origin, and the origin is stable."""
     equilibrium(facts, "V")
     neighbourhood(facts)
     V, beta = facts.value("V"), facts.level("beta")
-    domain, initial = facts.spec.domain, facts.role("initial")
-    facts.inside("relation:initial in domain", "I lies in D", facts.member(initial),
-                 facts.member(domain))
+    domain = facts.spec.domain
     if facts.discrete:  # a step can jump over ∂D: it must land in D (step_rules.py)
         facts.lands_in("condition:image", "f(x) lies in D for every x in D with V(x) <= β",
                        L.conjunction(facts.member(domain), compare("<=", V, beta)), domain)
     else:
         facts.holds("condition:boundary", "V(x) > β on the boundary of D",
                     facts.boundary(domain), compare(">", V, beta))
-    facts.holds("condition:initial", "V(x) <= β on I", facts.member(initial),
-                compare("<=", V, beta))
     # on the closure: the limit points of a trajectory in Ω lie there
     omega = L.conjunction(facts.closure(domain), compare("<=", V, beta))
     lyapunov_conditions(facts, omega, "Ω = {x in D : V(x) <= β}")
+    # with V(0) = 0 < β and V continuous, Ω holds a neighbourhood of the origin
     facts.obligations.append(Obligation("level:beta", "β > 0", compare("<=", beta)))
     if facts.r > 0:
         facts.holds("ball:sublevel", f"V(x) < β on the excluded ball |x| <= {facts.r}, "
                     "so no trajectory leaves Ω from it", facts.ball(facts.r),
                     compare("<", V, beta))
+
+
+def region_of_attraction(facts: Facts) -> None:
+    stable_sublevel_set(facts)
+    V, beta = facts.value("V"), facts.level("beta")
+    initial = facts.role("initial")
+    facts.inside("relation:initial in domain", "I lies in D", facts.member(initial),
+                 facts.member(facts.spec.domain))
+    facts.holds("condition:initial", "V(x) <= β on I", facts.member(initial),
+                compare("<=", V, beta))
+
+
+def largest_region_guarantee(discrete: bool) -> str:
+    kept = ("every step from Ω lands in D, and V decreases at every step"
+            if discrete else "V > β on the boundary of D, so Ω cannot be left, and V "
+            "strictly decreases along every trajectory")
+    return ("the origin is asymptotically stable and Ω = {x in D : V(x) <= β} lies in its "
+            f"region of attraction: every trajectory from Ω stays in Ω and converges to "
+            f"the origin, since {kept} on Ω away from the origin, where V is positive "
+            "(V(0) = 0 < β)")
+
+
+# `prove stable` with `region: largest`: the region is the result, there is no I
+rule("largest region of attraction", CONTINUOUS, DISCRETE,
+     guarantee=largest_region_guarantee)(stable_sublevel_set)
+strengthening("largest region of attraction", CONTINUOUS, name="no ball left out",
+              guarantee=largest_region_guarantee)(no_ball_left_out)
 
 
 rule("region of attraction", guarantee=ROA_GUARANTEE)(region_of_attraction)

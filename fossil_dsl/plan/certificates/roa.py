@@ -1,21 +1,26 @@
 """Region of attraction: I lies in the origin's basin, shown by a sublevel set of V."""
 from __future__ import annotations
 
+from fractions import Fraction
+
 from fossil_dsl.plan.certificates.base import (Certificate, Condition, Level, change_of, level_of,
                                                register, value_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
-from fossil_dsl.ir.sets import Boundary
+from fossil_dsl.ir.sets import Ball, Boundary, SetExpr
 from fossil_dsl.ir.spec import Layer
 
 DEFAULT_LAYERS = (Layer("square", 8),)
+# the forms whose certificate is a V with a sublevel set Ω in the region of attraction
+ROA_FORMS = ("region of attraction", "largest region of attraction")
 
 
 def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta",
-                   prefix: str = "") -> tuple[Condition, ...]:
+                   prefix: str = "", initial: SetExpr | None = None,
+                   initial_words: str = "I") -> tuple[Condition, ...]:
     """With Ω = {x in D : V(x) <= β}: V > β on ∂D (in discrete time: f(x) ∈ D for x in
-    Ω, since a step can jump over ∂D), V <= β on I, and V > 0, dV < 0 on Ω minus the
-    origin."""
+    Ω, since a step can jump over ∂D), V <= β on I (or `initial`), and V > 0, dV < 0 on
+    Ω minus the origin."""
     V, dV, beta = value_of(name), change_of(name), level_of(level)
     domain = certificate.spec.domain
     inside_level = L.Compare("<=", V, beta)
@@ -28,8 +33,8 @@ def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta
                          "of D", Boundary(domain), L.Compare(">", V, beta))
     return (
         kept,
-        Condition(f"{prefix}initial", f"{name}(x) <= β for every x in I",
-                  certificate.role("initial"), inside_level),
+        Condition(f"{prefix}initial", f"{name}(x) <= β for every x in {initial_words}",
+                  initial or certificate.role("initial"), inside_level),
         Condition(f"{prefix}positive", f"{name}(x) > 0 for every x ≠ 0 in Ω",
                   domain, L.Compare(">", V, E.ZERO), guard=inside_level,
                   exclude_origin=True, scaled_margin=True),
@@ -65,3 +70,34 @@ class RegionOfAttraction(Certificate):
     def levels(self):
         return (roa_level(self),)
 
+
+
+# the ball round the origin whose V the first β must cover, as a share of the distance
+# from the origin to the edge of D's bounding box (the kernel raises β from there)
+STARTING_BALL_SHARE = 0.05
+
+
+@register
+class LargestRegion(RegionOfAttraction):
+    """`prove stable` with `region: largest`: no initial set, so the search starts from
+    a small ball round the origin (a starting point, not an obligation: the kernel's
+    rule has no I) and the kernel raises β."""
+
+    form = "largest region of attraction"
+    title = "region-of-attraction certificate (Lyapunov function and its largest sublevel set)"
+
+    def conditions(self):
+        ball = self.starting_ball()
+        return roa_conditions(self, initial=ball,
+                              initial_words=f"{ball} (where the search starts)")
+
+    def levels(self):
+        return (Level("beta", "V", above=None, below="initial",
+                      text="β: just over the largest V on a small ball round the origin"),)
+
+    def starting_ball(self) -> Ball:
+        low, high = self.spec.domain.bounding_box() or ((-1.0,) * len(self.spec.states),
+                                                         (1.0,) * len(self.spec.states))
+        room = min(min(-a, b) for a, b in zip(low, high))
+        radius = float(f"{STARTING_BALL_SHARE * room:.2g}") if 0 < room < float("inf") else 0.05
+        return Ball((E.ZERO,) * len(self.spec.states), E.Num(Fraction(str(radius))))
