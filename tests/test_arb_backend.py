@@ -102,3 +102,19 @@ prove from init: always not unsafe
     assert all(c.reproved for c in checks), [c for c in checks if not c.reproved]
     by_interval = [c for c in checks if c.proved_by == "interval"]
     assert by_interval and all(c.solver == "arb" for c in by_interval)
+
+
+def test_nearly_cancelling_polynomials_are_refuted_by_the_mean_value_form():
+    """(x - y)^2 + 1/100 > 0, written expanded: on boxes along x = y the terms cancel, and
+    only the mean-value form (a table of coefficients and its exact gradient) refutes
+    them without bisecting to tiny widths. The query with - 1/100 holds on the diagonal
+    and is never refuted."""
+    expanded = E.add(E.mul(x, x), E.mul(num(-2), x, y), E.mul(y, y))
+    assert check(*box(-1, 1, x, y), L.Compare("<=", E.add(expanded, num("0.01")), num(0))) \
+        is Status.UNSAT
+    assert check(*box(-1, 1, x, y), L.Compare("<=", E.add(expanded, num("-0.01")), num(0))) \
+        is Status.UNKNOWN
+    # through a sine, the polynomial part is a table inside the tree
+    wrapped = L.Compare("<=", E.add(E.Apply("sin", x), E.neg(E.Apply("sin", x)),
+                                    expanded, num("0.01")), num(0))
+    assert check(*box(-1, 1, x, y), wrapped) is Status.UNSAT

@@ -105,3 +105,32 @@ def test_only_where_it_applies():
     plan = compile_spec(fossil_dsl.load(SPEC))
     given = replace(plan.spec, synthesis=replace(plan.spec.synthesis, candidate=E.Var("x0")))
     assert not basin.applies(replace(plan, spec=given))
+
+
+EULER_VDP = """\
+state x0, x1
+dynamics discrete {
+    next(x0) = x0 - 0.1*x1
+    next(x1) = x1 + 0.1*(x0 - (1 - x0^2)*x1)
+}
+domain box([-2.5, -3.5], [2.5, 3.5])
+prove stable
+synthesis { region: largest }
+"""
+
+
+def test_a_map_gets_a_function_with_the_step_conditions_at_the_origin(small):
+    """For x+ = f(x): V's quadratic part Q has Q - A^T Q A positive definite (A: the
+    map's Jacobian at 0), and {V <= 1} reaches past a quadratic's region."""
+    plan = compile_spec(fossil_dsl.loads(EULER_VDP))
+    assert basin.applies(plan)
+    found = basin.shaped_lyapunov(plan, deadline=float("inf"))
+    assert found is not None
+    V = P.polynomial(found.formula, plan.states)
+    Q = np.array([[float(V.get((2, 0), 0)), float(V.get((1, 1), 0)) / 2],
+                  [float(V.get((1, 1), 0)) / 2, float(V.get((0, 2), 0))]])
+    A = np.eye(2) + 0.1 * JACOBIAN
+    assert np.linalg.eigvalsh(Q).min() > 0
+    assert np.linalg.eigvalsh(Q - A.T @ Q @ A).min() > 0
+    at = np.asarray(evaluate(found.formula, state_env(plan.states, np.array([[1.5, 0.0]]))))
+    assert float(at.reshape(-1)[0]) < 1 and found.coverage > 0.8

@@ -13,6 +13,7 @@ import fossil_dsl
 from fossil_dsl.engine.evaluate import evaluate
 from fossil_dsl.engine.region import largest_level
 from fossil_dsl.kernel import Claim, judge, list_obligations
+from fossil_dsl.outputs.recheck import recheck
 
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "specs" / "roa_largest.fsl"
@@ -143,13 +144,41 @@ def test_the_largest_region_without_an_initial_set_end_to_end(tmp_path):
     xs, ys = np.meshgrid(grid, grid)
     values = evaluate(V, {"x": xs, "y": ys})
     assert np.all(np.abs(xs[values <= level]) < 1)
+    # every obligation re-proved by another procedure; V's degree-8 decrease, which the
+    # interval procedure or a refutation proved, by Arb's mean-value form
+    result.save(tmp_path)
+    checks = recheck(tmp_path)
+    assert all(c.reproved for c in checks), [c for c in checks if not c.reproved]
+
+
+def test_the_bisection_stays_below_a_sampled_failure():
+    """Levels above the smallest V at a sampled point where V stops decreasing are not
+    put to the kernel (each would cost it a timeout); the failure is a real one."""
+    spec = fossil_dsl.check_text(VDP_NO_INITIAL, "vdp.fsl").spec
+    claim = _vdp_claim(spec, Fraction(1, 10))
+    judge_ = Threshold()
+    found = largest_level(claim, Said(True, "start"), judge_, deadline=float("inf"))
+    assert found.failing is not None and Fraction(1, 2) < found.failing < 7
+    assert found.failing < found.upper and all(b < found.failing for b in judge_.asked)
+    assert not judge(_vdp_claim(spec, found.failing * Fraction(11, 10))).certified
+
+
+def test_a_map_without_an_initial_set_end_to_end():
+    """Discrete time: V shaped to the iterates' basin. The whole box converges; the
+    sum-of-squares V's region was the disc inside it (78 % of D)."""
+    result = fossil_dsl.synthesise(fossil_dsl.check_text(DISCRETE_NO_INITIAL, "map.fsl").spec,
+                                   timeout=120)
+    assert result.certified and "shaped to the simulated basin" in result.strategy
+    assert "asymptotically stable" in result.guarantee()
+    assert result.region["basin_coverage"] >= 0.95
+    assert result.region["region_points_not_converging"] == 0
 
 
 DISCRETE_NO_INITIAL = """\
 state x0, x1
 dynamics discrete {
-    next(x0) = 0.5*x0 + 0.1*x1^2
-    next(x1) = 0.5*x1
+    next(x0) = 0.5*x0 + 0.4*x1^2
+    next(x1) = 0.5*x1 + 0.3*x0*x1
 }
 domain box([-1, -1], [1, 1])
 prove stable

@@ -1,5 +1,5 @@
 """A Lyapunov function shaped to the simulated basin of attraction, for `region: largest`
-(continuous time, no inputs): the first attempt of such a run.
+(no inputs; continuous or discrete time): the first attempt of such a run.
 
 Points of D are simulated; those whose trajectory stays in D and reaches the origin are
 the basin's samples, the others (and samples of ∂D) lie outside any region that can be
@@ -8,8 +8,9 @@ degree 2..d) is then the solution of a conic program, linear in c:
 
     V >= 1                        on the samples outside the basin and on ∂D,
     V >= eps |y|^2                on the basin's samples,
-    dV/dt <= -eps |y|^2           where V <= 1 at the samples that need it (see below),
-    Q >= e I, -(A^T Q + Q A) >= e I
+    dV/dt <= -eps |y|^2           where V <= 1 at the samples that need it (see below;
+                                  for a map, V(f(x)) - V(x) <= -eps |y|^2),
+    Q >= e I, -(A^T Q + Q A) >= e I (Q - A^T Q A >= e I for a map)
                                   for V's quadratic part Q and the Jacobian A at the origin,
     minimise the mean of max(0, V - 1) over the basin's samples,
 
@@ -55,6 +56,7 @@ ADDED_PER_ROUND = 200
 CLOUD, CLOUD_RADIUS = 20, 0.01  # points round a counterexample, and their spread (of the scale)
 ROUNDS = 10
 HORIZON, STEP = 30.0, 0.02  # simulated time units, RK4 step
+ITERATES = 300  # of a map, simulated
 ARRIVED = 1e-2  # of the scale: a trajectory this close to the origin has converged
 STUCK = 1e-4  # a decrease slack (per |y|^2) above which the point is given up
 SIGNIFICANT = 7  # digits kept of each coefficient
@@ -78,7 +80,7 @@ class BasinFinding:
 def applies(plan: Plan) -> bool:
     spec = plan.spec
     return (plan.options.largest_region and plan.certificate.form in ROA_FORMS
-            and spec.time is TimeDomain.CONTINUOUS and not spec.inputs
+            and not spec.inputs
             and plan.controller is None and spec.torch_dynamics is None
             and spec.synthesis.certificate is None and spec.synthesis.candidate is None
             and spec.domain.bounding_box() is not None and _jacobian(plan) is not None)
@@ -146,6 +148,7 @@ class _Samples:
         low, high = (np.array([float(v) for v in side]) for side in spec.domain.bounding_box())
         self.scale = np.maximum(np.abs(low), np.abs(high))
         self.field = numeric_field(spec.dynamics, self.states)
+        self.discrete = spec.time is TimeDomain.DISCRETE
         self.jacobian = _jacobian(plan) * self.scale[None, :] / self.scale[:, None]
         self.in_domain = lambda x: np.asarray(holds(spec.domain.contains_formula(self.states),
                                                     state_env(self.states, x), len(x)), bool)
@@ -182,8 +185,9 @@ class _Samples:
     def _converges(self, points: np.ndarray) -> np.ndarray:
         """Where the simulated trajectory stays in D and ends near the origin."""
         x, kept = points.copy(), np.ones(len(points), bool)
-        for _ in range(int(HORIZON / STEP)):
-            x = np.clip(rk4_step(self.field, x, STEP), -1e6, 1e6)
+        for _ in range(ITERATES if self.discrete else int(HORIZON / STEP)):
+            x = np.clip(self.field(x) if self.discrete else rk4_step(self.field, x, STEP),
+                        -1e6, 1e6)
             kept &= np.isfinite(x).all(1) & self.in_domain(np.nan_to_num(x, nan=1e6))
         return kept & (np.linalg.norm(x / self.scale, axis=1) < ARRIVED)
 
@@ -218,7 +222,12 @@ class _Program:
         return np.prod(y[:, None, :] ** self.exponents[None, :, :], axis=2)
 
     def changes(self, x: np.ndarray) -> np.ndarray:
-        """d/dt of each monomial along the field at each point: shape [N, m]."""
+        """d/dt of each monomial along the field at each point (for a map, its change
+        over a step): shape [N, m]."""
+        if self.samples.discrete:
+            with np.errstate(all="ignore"):
+                return np.nan_to_num(self.values(self.samples.field(x)) - self.values(x),
+                                     nan=1e12, posinf=1e12, neginf=-1e12)
         y, dy = x / self.samples.scale, self.samples.field(x) / self.samples.scale
         total = np.zeros((len(x), len(self.exponents)))
         for i in range(y.shape[1]):

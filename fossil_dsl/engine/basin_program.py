@@ -2,7 +2,7 @@
 (monomials of y = x / scale), a hinge h >= V - 1 on each basin sample, a slack t >= 0 on
 each decrease point; linear rows for the sampled conditions (each divided by |y|^2, so
 points near the origin weigh like the others) and two positive semidefinite cones for
-V's quadratic part Q: Q >= e I and -(A^T Q + Q A) >= e I. The program object supplies
+V's quadratic part Q: Q >= e I and -(A^T Q + Q A) >= e I (Q - A^T Q A >= e I for a map). The program object supplies
 `values`, `changes`, `exponents` and `samples` (`squared`, `jacobian`)."""
 from __future__ import annotations
 
@@ -59,8 +59,9 @@ def solve_conic(program, basin, outside, decrease, deadline: float):
 
 
 def _local_cones(program, count: int):
-    """Rows for Q - e I >= 0 and -(A^T Q + Q A) - e I >= 0 (e = LOCAL_EPS; PSD, Clarabel's scaled
-    upper triangles), with Q the quadratic part of V in c's coordinates."""
+    """Rows for Q - e I >= 0 and -(A^T Q + Q A) - e I >= 0 (for a map Q - A^T Q A - e I
+    >= 0; e = LOCAL_EPS; PSD, Clarabel's scaled upper triangles), with Q the quadratic
+    part of V in c's coordinates."""
     n = program.samples.jacobian.shape[0]
     A = program.samples.jacobian
     index = {tuple(e): k for k, e in enumerate(program.exponents.tolist())}
@@ -69,9 +70,10 @@ def _local_cones(program, count: int):
         exponent = tuple(int(k == i) + int(k == j) for k in range(n))
         return {index[exponent]: 1.0 if i == j else 0.5}
     Q = [[q(i, j) for j in range(n)] for i in range(n)]
-    lyapunov = [[_sum([_scaled(Q[k][j], -A[k, i]) for k in range(n)]
-                      + [_scaled(Q[i][k], -A[k, j]) for k in range(n)])
-                 for j in range(n)] for i in range(n)]
+    lyapunov = (_step_lyapunov(Q, A) if program.samples.discrete else
+                [[_sum([_scaled(Q[k][j], -A[k, i]) for k in range(n)]
+                       + [_scaled(Q[i][k], -A[k, j]) for k in range(n)])
+                  for j in range(n)] for i in range(n)])
     rows, right = [], []
     for matrix in (Q, lyapunov):
         for j in range(n):
@@ -84,6 +86,14 @@ def _local_cones(program, count: int):
                 right.append(-LOCAL_EPS if i == j else 0.0)
     from scipy import sparse
     return n, sparse.csr_matrix(np.array(rows)), np.array(right)
+
+
+def _step_lyapunov(Q, A) -> list[list[dict[int, float]]]:
+    """Q - A^T Q A, entry by entry (a map's decrease at the origin)."""
+    n = len(Q)
+    return [[_sum([Q[i][j]] + [_scaled(Q[k][l], -A[k, i] * A[l, j])
+                                for k in range(n) for l in range(n)])
+             for j in range(n)] for i in range(n)]
 
 
 def _scaled(entry: dict[int, float], factor: float) -> dict[int, float]:

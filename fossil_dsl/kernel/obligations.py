@@ -52,6 +52,7 @@ class Obligation:
     name: str
     text: str
     query: L.Formula  # satisfiable exactly when the fact fails
+    first: str = ""  # the procedure to try first (only the order changes, never a verdict)
 
     @property
     def file_stem(self) -> str:
@@ -131,11 +132,12 @@ class Facts:
         return L.Compare("<=", self.squared_norm(), E.Num(radius ** 2))
 
     # ---- obligations ----
-    def never(self, name: str, text: str, region: L.Formula, failure: L.Formula) -> None:
+    def never(self, name: str, text: str, region: L.Formula, failure: L.Formula,
+              first: str = "") -> None:
         """`failure` never happens in `region`; the expressions of `failure` are also
         obligated to be defined throughout `region`."""
         self.defined(name, region, _expressions(failure))
-        self.obligations.append(Obligation(name, text, L.conjunction(region, failure)))
+        self.obligations.append(Obligation(name, text, L.conjunction(region, failure), first))
 
     def lands_in(self, name: str, text: str, region: L.Formula, target: S.SetExpr) -> None:
         """Every x in `region` is mapped into `target` by one step of the closed loop."""

@@ -92,7 +92,7 @@ def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: st
     early = len(states) >= BEFORE_Z3_FROM  # the refutation before Z3
     # Z3 stalls for its whole share on polynomials of high degree (a degree-8 V shaped
     # to a basin: 18 s per condition) where the interval procedure answers in seconds
-    high = _degree(obligation.query, states) >= INTERVAL_FIRST_DEGREE
+    high = bisection_first(obligation.query, states)
     order = sorted(SHARES, key=lambda name: (name != first,
                                              not (high and name == "interval"),
                                              not (early and name == SUM_OF_SQUARES)))
@@ -113,6 +113,12 @@ def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: st
                          _point(answer, states))
         reasons.append(f"{name}: {_reason(answer)}")
     return Proof(obligation, Outcome.NOT_PROVED, ", ".join(order), "; ".join(reasons))
+
+
+def bisection_first(query: L.Formula, states) -> bool:
+    """Whether a bisection procedure should go before Z3: a polynomial of high degree in
+    few states."""
+    return _degree(query, states) >= INTERVAL_FIRST_DEGREE
 
 
 def _degree(query: L.Formula, states) -> int:

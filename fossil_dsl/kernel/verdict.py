@@ -79,7 +79,8 @@ def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
     The procedure that proved a condition in the run goes first (only the order)."""
     proofs = []
     for obligation in obligations:
-        first = claim.procedures.get(obligation.name.removeprefix("condition:"), "")
+        first = claim.procedures.get(obligation.name.removeprefix("condition:"),
+                                     obligation.first)
         proofs.append(discharge(obligation, claim.spec.states, timeout, delta, first,
                                 claim.refutations.get(obligation.name), pieces))
         if not proofs[-1].proved:

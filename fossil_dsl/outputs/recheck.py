@@ -25,7 +25,7 @@ from fossil_dsl.kernel import Claim, NoRule, list_obligations
 from fossil_dsl.kernel.export import script
 from fossil_dsl.kernel.obligations import file_stem
 from fossil_dsl.solvers.positivstellensatz import refutation_from_json, refutation_problem
-from fossil_dsl.kernel.prove import SUM_OF_SQUARES
+from fossil_dsl.kernel.prove import SUM_OF_SQUARES, bisection_first
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.api import Status
 from fossil_dsl.solvers.smtlib_reader import SmtlibError, read_script
@@ -37,7 +37,11 @@ from fossil_dsl.syntax.parser import parse_expression, parse_source
 # sum-of-squares procedure comes second: it shares no code with the SMT solvers, and
 # what it finds is checked in exact arithmetic (4- to 6-state flow conditions that Z3
 # proved in the run were left UNKNOWN by CVC5 and the interval search at 10 s each).
-POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "dreal")
+POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "arb", "dreal")
+# ... but Arb first for a polynomial of high degree in few states (kernel/prove.py's
+# rule for the interval procedure): a degree-8 decrease condition of a V shaped to a
+# basin, which the interval procedure proved in the run, was left UNKNOWN by CVC5, the
+# sum-of-squares procedure and Z3 at 20 s each; Arb's mean-value form refutes it in 4 s
 # Arb's ball arithmetic (solvers/arb_backend.py) is the other procedure for a
 # transcendental query the interval verifier proved: CVC5 left four BarrierBench flow
 # conditions with sin and cos UNKNOWN at 60 s, which Arb refutes in 0.7 to 9 s.
@@ -235,9 +239,12 @@ def _backend(name: str):
 def other_solvers(used: str, formula: L.Formula) -> list[str]:
     """The installed solvers other than `used` suited to the formula, best first."""
     sides = [side for c in L.comparisons(formula) for side in (c.left, c.right)]
-    order = POLYNOMIAL_ORDER if all(map(traversal.is_polynomial, sides)) \
+    polynomial = all(map(traversal.is_polynomial, sides))
+    order = POLYNOMIAL_ORDER if polynomial \
         else ARITHMETIC_ORDER if all(map(traversal.is_arithmetic, sides)) \
         else TRANSCENDENTAL_ORDER
+    if polynomial and bisection_first(formula, sorted(L.free_vars(formula))):
+        order = ("arb",) + tuple(n for n in order if n != "arb")
     if not L.free_vars(formula):  # a fact about numbers: no box to search
         order = ("z3", "cvc5")
     return [n for n in order if n != used

@@ -35,6 +35,7 @@ def region_report(result, found) -> dict:
         "method": "the largest level beta the kernel proves for V (bisection), with "
                   "every region-of-attraction obligation proved at it",
         "level": str(found.level), "level_upper_bound": float(found.upper),
+        "level_failing_sample": None if found.failing is None else float(found.failing),
         "levels_tried": [{"beta": str(b), "proved": ok} for b, ok in found.tried],
         "samples": SAMPLES, "samples_in_domain": int(in_domain.sum()),
         "share_of_domain": _share(inside.sum(), in_domain.sum()),

@@ -56,6 +56,9 @@ def region_line(region: dict) -> str:
     tried = len(region["levels_tried"])
     refused = [float(Fraction(t["beta"])) for t in region["levels_tried"] if not t["proved"]]
     cap = f"the smallest level not proved: {min(refused):.4g}; " if refused else ""
+    failing = region.get("level_failing_sample")
+    if failing is not None and failing < region["level_upper_bound"]:
+        cap += f"a sampled point of D fails a condition at V = {failing:.4g}; "
     coverage = region["basin_coverage"]
     basin = "no sampled point of D converges" if coverage is None else \
         f"{100 * coverage:.1f} % of the simulated basin within D"

@@ -26,10 +26,12 @@ from typing import Sequence
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.calculus import derivative
 from fossil_dsl.solvers.api import Answer, Status
 
 SMALLEST = 1e-12  # a box this narrow (relative to the start) that is not refuted: give up
 BELOW, ABOVE = ("<", "<="), (">", ">=")
+TABLE_TERMS = 4  # a polynomial part with this many terms is evaluated as a table
 
 
 class ArbBackend:
@@ -45,7 +47,18 @@ class ArbBackend:
         if any(lo > hi for lo, hi in box):  # bounds implied by conjuncts contradict
             return Answer(Status.UNSAT, solver=self.name)
         refuter = _Refuter(flint.arb, names)
-        return _search(refuter, formula, box, time.monotonic() + timeout, stop)
+        return _search(refuter, _inward(formula), box, time.monotonic() + timeout, stop)
+
+
+def _inward(formula: L.Formula) -> L.Formula:
+    """The formula with every negation moved onto its comparisons, once: the search then
+    meets the same comparison objects in every box (their tables are kept by identity)."""
+    if isinstance(formula, L.Not):
+        return _inward(L.negated_inward(formula.arg))
+    if isinstance(formula, (L.And, L.Or)):
+        parts = [_inward(arg) for arg in formula.args]
+        return L.conjunction(*parts) if isinstance(formula, L.And) else L.disjunction(*parts)
+    return formula
 
 
 def _search(refuter, formula, start, deadline: float, stop) -> Answer:
@@ -74,11 +87,16 @@ def _search(refuter, formula, start, deadline: float, stop) -> Answer:
 class _Refuter:
     def __init__(self, arb, names):
         self.arb = arb
+        self.names = names
         self.index = {name: i for i, name in enumerate(names)}
+        self.gradients: dict[int, tuple] = {}  # id -> (comparison kept alive, tables)
+        self.tables: dict[int, tuple] = {}  # id -> (expression kept alive, table or None)
+        self.numbers: dict[int, tuple] = {}  # id -> (number kept alive, its ball)
 
     def refutes(self, formula: L.Formula, box) -> bool:
         """Whether no point of the box satisfies the formula (False: not shown)."""
         values = [self.arb(lo).union(self.arb(hi)) for lo, hi in box]
+        self.box = box
         return self._refutes(formula, values, {})
 
     def _refutes(self, formula: L.Formula, values, memo) -> bool:
@@ -91,12 +109,72 @@ class _Refuter:
         if isinstance(formula, L.Or):
             return all(self._refutes(arg, values, memo) for arg in formula.args)
         if isinstance(formula, L.Compare) and formula.relation in BELOW + ABOVE:
-            difference = self.enclose(E.add(formula.left, E.neg(formula.right)), values, memo)
-            if difference is None:
+            difference, gradient = self._difference(formula)
+            value = difference.enclose(self, values, memo)
+            if value is None:
                 return False
+            if not _excludes(value, formula.relation) and gradient is not None:
+                value = self._mean_value(difference, gradient, values, memo)
             # the closure of the comparison's set: d <= 0 (or d >= 0) cannot hold
-            return bool(difference > 0) if formula.relation in BELOW else bool(difference < 0)
+            return value is not None and _excludes(value, formula.relation)
         return False
+
+    def _number(self, expr: E.Num):
+        key = id(expr)
+        if key not in self.numbers:
+            self.numbers[key] = (expr, _rational(self.arb, expr.value))
+        return self.numbers[key][1]
+
+    def _table(self, expr: E.Expr):
+        """A polynomial part of a larger expression (the gradient of V in dV/dt with sin
+        in the field) as a coefficient table, evaluated at once; None for other parts."""
+        if not isinstance(expr, (E.Add, E.Mul)):
+            return None
+        key = id(expr)
+        if key not in self.tables:
+            try:
+                table = P.polynomial(expr, self.names)
+            except ValueError:
+                table = None
+            self.tables[key] = (expr, None if table is None or len(table) < TABLE_TERMS
+                                else _Table(self.arb, table, len(self.names)))
+        return self.tables[key][1]
+
+    def _mean_value(self, difference, gradient, values, memo):
+        """d(c) + sum_i (∂d/∂x_i on the box) (x_i - c_i), c the box's centre (the mean
+        value theorem; far tighter than d's own enclosure on small boxes where d's terms
+        nearly cancel), or None where a part has no finite enclosure."""
+        centre = [(lo + hi) / 2 for lo, hi in self.box]
+        total = difference.enclose(self, [self.arb(c) for c in centre], {})
+        if total is None:
+            return None
+        for slope_of, value, c in zip(gradient, values, centre):
+            slope = slope_of.enclose(self, values, memo)
+            if slope is None:
+                return None
+            total += slope * (value - self.arb(c))
+        return total
+
+    def _difference(self, formula: L.Compare):
+        """(d, its gradient or None) for the comparison's left - right: as coefficient
+        tables where d is a polynomial (quick to evaluate), else as expressions (None
+        where d is not differentiable)."""
+        key = id(formula)  # the formula is kept with its entry, so its id is not reused
+        if key not in self.gradients:
+            expr = E.add(formula.left, E.neg(formula.right))
+            try:
+                table = P.polynomial(expr, self.names)
+                found = (_Table(self.arb, table, len(self.names)),
+                         [_Table(self.arb, _partial(table, i), len(self.names))
+                          for i in range(len(self.names))])
+            except ValueError:
+                try:
+                    gradient = [_Tree(derivative(expr, name)) for name in self.names]
+                except (E.ExprError, ValueError, KeyError, TypeError):
+                    gradient = None
+                found = (_Tree(expr), gradient)
+            self.gradients[key] = (formula, found)
+        return self.gradients[key][1]
 
     def enclose(self, expr: E.Expr, values, memo):
         """A ball holding every value of the expression on the box, or None where
@@ -108,8 +186,11 @@ class _Refuter:
 
     def _enclose(self, expr: E.Expr, values, memo):
         arb = self.arb
+        table = self._table(expr)
+        if table is not None:
+            return table.enclose(self, values, memo)
         if isinstance(expr, E.Num):
-            return _rational(arb, expr.value)
+            return self._number(expr)
         if isinstance(expr, E.Pi):
             return arb.pi()
         if isinstance(expr, E.Var):
@@ -135,6 +216,51 @@ class _Refuter:
         return None
 
 
+class _Tree:
+    """An expression, enclosed node by node."""
+
+    def __init__(self, expr: E.Expr):
+        self.expr = expr
+
+    def enclose(self, refuter: _Refuter, values, memo):
+        return refuter.enclose(self.expr, values, memo)
+
+
+class _Table:
+    """A polynomial as (coefficient, exponents) rows: each power of each variable is
+    enclosed once per box (even powers tightly), then the rows are summed."""
+
+    def __init__(self, arb, table: dict, n: int):
+        self.rows = [(_rational(arb, Fraction(c)), m) for m, c in table.items() if c]
+        self.top = max((max(m) for m in table), default=0)
+        self.zero = arb(0)
+
+    def enclose(self, refuter: _Refuter, values, memo):
+        powers = [[_integer_power(v, k) for k in range(self.top + 1)] for v in values]
+        total = self.zero
+        for coefficient, exponents in self.rows:
+            term = coefficient
+            for i, k in enumerate(exponents):
+                if k:
+                    term = term * powers[i][k]
+            total = total + term
+        return total
+
+
+def _partial(table: dict, i: int) -> dict:
+    """∂p/∂x_i of a polynomial table, exactly."""
+    found = {}
+    for exponents, c in table.items():
+        if exponents[i]:
+            lowered = exponents[:i] + (exponents[i] - 1,) + exponents[i + 1:]
+            found[lowered] = found.get(lowered, 0) + Fraction(c) * exponents[i]
+    return found
+
+
+def _excludes(difference, relation: str) -> bool:
+    return bool(difference > 0) if relation in BELOW else bool(difference < 0)
+
+
 def _rational(arb, value: Fraction):
     return arb(value.numerator) / arb(value.denominator)
 
@@ -143,7 +269,10 @@ def _product(factors, parts):
     """x*x as a square (ball multiplication does not know both factors are one)."""
     result, seen = None, {}
     for factor, part in zip(factors, parts):
-        seen.setdefault(factor, [part, 0])[1] += 1
+        # a variable by its name, anything else by identity (hashing a whole subtree
+        # for every box cost more than the rest of the search)
+        key = factor.name if isinstance(factor, E.Var) else id(factor)
+        seen.setdefault(key, [part, 0])[1] += 1
     for part, count in seen.values():
         term = _integer_power(part, count)
         result = term if result is None else result * term

@@ -1,0 +1,7 @@
+; vdp_mu3: level:beta: β > 0
+; unsat means the obligation holds
+(set-logic QF_NRA)
+(declare-const x0 Real)
+(declare-const x1 Real)
+(assert (<= (/ 993.0 1000.0) 0.0))
+(check-sat)
