@@ -192,3 +192,23 @@ def _vdp_claim(spec, beta):
     # A^T P + P A = -I for A = [[0, -1], [1, -1]]: P = [[3/2, -1/2], [-1/2, 1]]
     V = E.add(E.mul(E.Num(Fraction(3, 2)), x0, x0), E.neg(E.mul(x0, x1)), E.mul(x1, x1))
     return Claim(spec, {"V": V}, {}, {"beta": beta})
+
+
+def test_a_trajectory_that_blows_up_never_counts_as_converging():
+    """x1' = -x1 + 2 x1^2 x2, x2' = -x2 blows up in finite time where x1 x2 > 1; a path
+    held at a bound while x2 decays used to come back to the origin and counted as in
+    the basin (the report said all of D converged)."""
+    from fossil_dsl.outputs.region import converges
+    text = """\
+state x1, x2
+dynamics continuous {
+    x1' = -x1 + 2*x1^2*x2
+    x2' = -x2
+}
+domain box([-2, -2], [2, 2])
+prove stable
+synthesis { candidate: x1^2 + x2^2 }
+"""
+    result = fossil_dsl.synthesise(fossil_dsl.check_text(text, "hahn.fsl").spec, timeout=30)
+    points = np.array([[2.0, 2.0], [1.5, 1.5], [0.5, 0.5], [-2.0, 2.0]])
+    assert converges(result, points).tolist() == [False, False, True, True]

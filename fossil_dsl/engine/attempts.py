@@ -71,9 +71,7 @@ def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
     for _ in range(BASIN_REFINEMENTS + 1):
         if finding is None or time.monotonic() > deadline:
             break
-        given, outcome = _given(_ball_left_out(plan, finding), backend, listener, deadline,
-                                finding, BASIN_QUERY_SECONDS,
-                                time.monotonic() + BASIN_REFUTING_SECONDS)
+        given, outcome = _shaped_proof(plan, finding, backend, listener, deadline)
         if outcome.certified:
             return (given, replace(outcome, strategy=finding.describe())), ""
         note = f"{finding.describe()}: not proved: {outcome.reason}"
@@ -85,13 +83,28 @@ def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
     return None, note
 
 
-def _ball_left_out(plan: Plan, finding) -> Plan:
+def _shaped_proof(plan: Plan, finding, backend: Backend, listener, deadline: float):
+    """(plan with V given, outcome): proved with the ball the Taylor lemma needs, else
+    (where that is not proved: a ball of 1/1600 was too small for the interval
+    procedure's boxes near the origin) with the plan's own ball, ε-stability rather
+    than nothing; the counterexamples are then the latter's."""
+    radius = plan.origin_radius or origin_radius(plan.spec)
+    lemma = _ball_left_out(plan, finding, radius)
+    for attempt in (lemma,) if lemma.origin_radius == radius else \
+            (lemma, replace(plan, origin_radius=radius)):
+        given, outcome = _given(attempt, backend, listener, deadline, finding,
+                                BASIN_QUERY_SECONDS, time.monotonic() + BASIN_REFUTING_SECONDS)
+        if outcome.certified or time.monotonic() > deadline:
+            break
+    return given, outcome
+
+
+def _ball_left_out(plan: Plan, finding, radius) -> Plan:
     """The plan with the ball round the origin that the conditions leave out: the
     neighbourhood of the origin goes to the kernel's Taylor lemma (a polynomial of degree
     8 near 0 is beyond Z3, and a numerical procedure needs the ball excluded), so the
     ball is made small enough for the lemma's estimates where halving it helps (a
     quadratic part nearly flat in one direction needs a smaller ball)."""
-    radius = plan.origin_radius or origin_radius(plan.spec)
     claim = Claim(plan.spec, {plan.functions[0].name: finding.formula}, {}, {}, radius)
     return replace(plan, origin_radius=lemma_radius(claim) or radius)
 

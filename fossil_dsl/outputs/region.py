@@ -17,6 +17,7 @@ from fossil_dsl.outputs.simulate import closed_loop, in_region, rk4_step
 
 SAMPLES = 4000  # points drawn uniformly in D's bounding box
 STEPS = 4000  # integration steps (or iterations of a map)
+ESCAPE = 1e6  # a coordinate this large: the path has diverged
 CONVERGED = 1e-3  # of D's size: where a trajectory counts as at the origin
 
 
@@ -59,7 +60,12 @@ def converges(result, points, steps: int = STEPS, horizon: float = 40.0,
     `steps` of RK4 over `horizon` time units, or `steps` iterations of a map."""
     field, x = closed_loop(result), points.copy()
     discrete = result.plan.spec.time is TimeDomain.DISCRETE
+    escaped = np.zeros(len(points), bool)
     for _ in range(steps):
-        x = field(x) if discrete else rk4_step(field, x, horizon / steps)
-        x = np.clip(x, -1e6, 1e6)  # a diverging path stays finite (and far)
-    return np.isfinite(x).all(1) & (np.linalg.norm(x, axis=1) < near)
+        with np.errstate(all="ignore"):
+            x = field(x) if discrete else rk4_step(field, x, horizon / steps)
+        # a path past the bound has diverged: it is marked for good, since held at the
+        # bound it could drift back (x1' = -x1 + 2 x1^2 x2 with x2 -> 0 did)
+        escaped |= ~np.isfinite(x).all(1) | (np.abs(x) > ESCAPE).any(1)
+        x[escaped] = ESCAPE
+    return ~escaped & (np.linalg.norm(x, axis=1) < near)

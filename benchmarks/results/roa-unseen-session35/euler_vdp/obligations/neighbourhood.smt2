@@ -1,0 +1,7 @@
+; euler_vdp: neighbourhood: the origin is an interior point of D (D contains a neighbourhood of it)
+; unsat means the obligation holds
+(set-logic QF_NRA)
+(declare-const x0 Real)
+(declare-const x1 Real)
+(assert (not (and (< (- (/ 5.0 2.0)) 0.0) (< 0.0 (/ 5.0 2.0)) (< (- (/ 7.0 2.0)) 0.0) (< 0.0 (/ 7.0 2.0)))))
+(check-sat)

@@ -1,0 +1,7 @@
+; khalil_saddles: level:beta: β > 0
+; unsat means the obligation holds
+(set-logic QF_NRA)
+(declare-const x1 Real)
+(declare-const x2 Real)
+(assert (<= (/ 9847.0 10000.0) 0.0))
+(check-sat)

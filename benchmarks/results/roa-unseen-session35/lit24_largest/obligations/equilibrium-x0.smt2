@@ -1,0 +1,8 @@
+; lit24_lorenz_subcritical_roa: equilibrium:x0: f0(0) = 0 (the origin is an equilibrium)
+; unsat means the obligation holds
+(set-logic QF_NRA)
+(declare-const x0 Real)
+(declare-const x1 Real)
+(declare-const x2 Real)
+(assert (or (< 0.0 0.0) (> 0.0 0.0)))
+(check-sat)

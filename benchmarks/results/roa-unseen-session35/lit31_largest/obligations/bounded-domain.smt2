@@ -1,0 +1,7 @@
+; lit31_rational_roa: bounded:domain: the domain D lies in the box [-3, 3] x [-3, 3]
+; unsat means the obligation holds
+(set-logic QF_NRA)
+(declare-const x0 Real)
+(declare-const x1 Real)
+(assert (and (<= (+ (* x0 x0) (* x1 x1)) 4.0) (not (and (<= (- 3.0) x0) (<= x0 3.0) (<= (- 3.0) x1) (<= x1 3.0)))))
+(check-sat)
