@@ -18,7 +18,6 @@ makes the answer UNKNOWN: the search covers bounded boxes only.
 """
 from __future__ import annotations
 
-import math
 import time
 from fractions import Fraction
 from typing import Sequence
@@ -28,9 +27,9 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.calculus import derivative
 from fossil_dsl.solvers.api import Answer, Status
+from fossil_dsl.solvers.arb_box import ABOVE, BELOW, starting_box
 
 SMALLEST = 1e-12  # a box this narrow (relative to the start) that is not refuted: give up
-BELOW, ABOVE = ("<", "<="), (">", ">=")
 TABLE_TERMS = 4  # a polynomial part with this many terms is evaluated as a table
 
 
@@ -299,92 +298,3 @@ def _integer_power(base, n: int):
 
 def _abs(arb, value):
     return value.abs_lower().union(value.abs_upper())
-
-
-def starting_box(formula: L.Formula, names) -> list[tuple[float, float]] | None:
-    """Float bounds (rounded outwards) for each variable from the query's top-level
-    conjuncts, or None where some variable gets none."""
-    low = {name: -math.inf for name in names}
-    high = {name: math.inf for name in names}
-    for atom in _conjuncts(formula):
-        for name, lower, upper in _bounds(atom, names):
-            low[name] = max(low[name], lower)
-            high[name] = min(high[name], upper)
-    if not all(math.isfinite(low[n]) and math.isfinite(high[n]) for n in names):
-        return None
-    return [(low[n], high[n]) for n in names]
-
-
-def _conjuncts(formula: L.Formula) -> list[L.Formula]:
-    if isinstance(formula, L.And):
-        return [atom for arg in formula.args for atom in _conjuncts(arg)]
-    if isinstance(formula, L.Not) and isinstance(formula.arg, L.Compare):
-        return [L.negated_inward(formula)]
-    return [formula]
-
-
-def _bounds(atom: L.Formula, names):
-    """(variable, lower, upper) that the comparison implies: from `x <= c`, `c <= x`, and
-    an axis-parallel ellipsoid `sum a_i (x_i - c_i)^2 <= r`."""
-    if not isinstance(atom, L.Compare) or atom.relation not in BELOW + ABOVE:
-        return []
-    small, large = (atom.left, atom.right) if atom.relation in BELOW \
-        else (atom.right, atom.left)
-    try:
-        polynomial = P.polynomial(E.add(small, E.neg(large)), names)  # <= 0
-    except ValueError:
-        return []
-    return _ellipsoid_bounds(polynomial, names)
-
-
-def _ellipsoid_bounds(polynomial: dict, names):
-    """For p(x) <= 0 with p = sum (a_i x_i^2 + b_i x_i) + k, every a_i >= 0 (no products
-    of two variables): |x_i + b_i / 2a_i| <= sqrt(R / a_i), R = sum b_i^2 / 4a_i - k,
-    where a_i > 0; x_i <= -k / b_i (or >=) where p is linear in x_i alone."""
-    n = len(names)
-    square, linear, constant = {}, {}, Fraction(0)
-    for monomial, coefficient in polynomial.items():
-        degree = sum(monomial)
-        if degree == 0:
-            constant = Fraction(coefficient)
-        elif degree == 1 or (degree == 2 and max(monomial) == 2):
-            i = max(range(n), key=lambda j: monomial[j])
-            (square if degree == 2 else linear)[i] = Fraction(coefficient)
-        else:
-            return []
-    if any(a <= 0 for a in square.values()):
-        return []
-    if not square:
-        if len(linear) != 1:
-            return []
-        (i, b), = linear.items()
-        edge = -constant / b
-        return [(names[i], -math.inf, _up(edge))] if b > 0 else [(names[i], _down(edge), math.inf)]
-    if set(linear) - set(square):
-        return []
-    radius = sum(linear.get(i, 0) ** 2 / (4 * a) for i, a in square.items()) - constant
-    if radius < 0:
-        return []
-    found = []
-    for i, a in square.items():
-        centre = -Fraction(linear.get(i, 0)) / (2 * a)
-        reach = Fraction(_sqrt_up(radius / a))
-        found.append((names[i], _down(centre - reach), _up(centre + reach)))
-    return found
-
-
-def _sqrt_up(value: Fraction) -> float:
-    root = math.sqrt(_up(value))
-    while Fraction(root) ** 2 < value:
-        root = math.nextafter(root, math.inf)
-    return root
-
-
-def _up(value: Fraction) -> float:
-    near = float(value)
-    return near if Fraction(near) >= value else math.nextafter(near, math.inf)
-
-
-def _down(value: Fraction) -> float:
-    near = float(value)
-    return near if Fraction(near) <= value else math.nextafter(near, -math.inf)
