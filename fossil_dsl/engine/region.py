@@ -6,8 +6,8 @@ the largest level β for which the kernel proves every obligation again, so that
 boundary of D (no larger β can satisfy V > β there), or, lower, the smallest value of V
 at a sampled point of D where a condition fails in floating point (V not positive, not
 decreasing, or, for a map, a step leaving D): such a level would only cost the kernel a
-timeout. First just under that upper end (enough if proved), then by bisection. Each candidate is judged by
-the kernel from scratch (the `judge` the caller passes); the answer is the last β it
+timeout. First just under that upper end (enough if proved), then by bisection. Each
+candidate is judged by the kernel from scratch (the `judge` the caller passes); the answer is the last β it
 certified, with that verdict. Nothing here proves anything.
 """
 from __future__ import annotations
@@ -21,8 +21,9 @@ import numpy as np
 
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
 from fossil_dsl.engine.sampling import sample
+from fossil_dsl.engine.trajectories import column, numeric_field
 from fossil_dsl.ir import traversal
-from fossil_dsl.ir.calculus import derivative
+from fossil_dsl.ir.calculus import lie_derivative
 from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.kernel import Claim, Verdict
@@ -90,19 +91,17 @@ def _failing_level(claim: Claim, seed: int) -> Fraction | None:
     with np.errstate(all="ignore"):
         value = _values(V, states, points)
         if spec.time is TimeDomain.DISCRETE:
-            image = np.stack([_values(f, states, points) for f in field], 1)
+            image = numeric_field(field, states)(points)
             fails = ~_inside(spec.domain, states, image)
             change = np.where(fails, 0.0, _values(V, states, np.nan_to_num(image)) - value)
         else:
-            change = sum(_values(derivative(V, s), states, points) * _values(f, states, points)
-                         for s, f in zip(states, field))
+            change = _values(lie_derivative(V, states, field), states, points)
         bad = (~np.isfinite(change) | (change >= 0) | (value <= 0)) & np.isfinite(value)
     return Fraction(float(np.min(value[bad]))) if bad.any() else None
 
 
 def _values(expr, states, points) -> np.ndarray:
-    return np.broadcast_to(np.asarray(evaluate(expr, state_env(states, points)), np.float64),
-                           (len(points),))
+    return column(evaluate(expr, state_env(states, points)), len(points))
 
 
 def _inside(region, states, points) -> np.ndarray:

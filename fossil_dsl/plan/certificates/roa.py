@@ -71,7 +71,6 @@ class RegionOfAttraction(Certificate):
         return (roa_level(self),)
 
 
-
 # the ball round the origin whose V the first β must cover, as a share of the distance
 # from the origin to the edge of D's bounding box (the kernel raises β from there)
 STARTING_BALL_SHARE = 0.05
