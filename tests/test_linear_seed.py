@@ -68,3 +68,37 @@ def test_the_seed_is_certified_in_the_first_iteration():
     for text in (POLYNOMIAL, PENDULUM):
         result = fossil_dsl.synthesise(fossil_dsl.loads(text), seed=0)
         assert result.certified and result.iterations == 1, result.reason
+
+
+MOORE_GREITZER = """\
+state x0, x1
+input u0
+dynamics continuous {
+    x0' = -x1 - 1.5*x0^2 - 0.5*x0^3
+    x1' = u0
+}
+domain box([-2, -2], [2, 2])
+set init = box([-0.2, -0.2], [0.2, 0.2])
+prove from init: stable
+"""
+
+
+def _seeded(text: str) -> Learner:
+    plan = compile_spec(fossil_dsl.loads(text))
+    torch.manual_seed(0)
+    return Learner(plan, torch.Generator().manual_seed(0))
+
+
+def test_a_controller_seed_is_chosen_among_lqr_weightings_where_identity_fails():
+    """Moore-Greitzer: with identity weights the closed loop has a second equilibrium at
+    (-0.45, -0.26), next to I, and the quadratic fails on the samples; another weighting's
+    gain meets every condition there, and the learner starts from it."""
+    learner = _seeded(MOORE_GREITZER)
+    _, satisfied = learner.loss()
+    assert learner.seeded and satisfied
+    _, K = local_certificate(fossil_dsl.loads(MOORE_GREITZER), controlled=True)
+    with torch.no_grad():
+        gain = learner.controller(torch.eye(2, dtype=torch.float64)).numpy().ravel()
+    assert not np.allclose(gain, -K.ravel(), atol=1e-3)  # not the identity weights' gain
+    result = fossil_dsl.synthesise(fossil_dsl.loads(MOORE_GREITZER), timeout=60)
+    assert result.certified, result.summary()

@@ -9,9 +9,10 @@ import time
 import numpy as np
 from dataclasses import replace
 
-from fossil_dsl.engine import basin, sos
+from fossil_dsl.engine import basin, sos, sos_reach
 from fossil_dsl.engine.sos_barrier import barrier
-from fossil_dsl.engine.loop import Cegis, CegisOutcome, IterationRecord, Verdict, as_listener
+from fossil_dsl.engine.loop import (Cegis, CegisOutcome, IterationRecord, Verdict, as_listener,
+                                    failure_reason)
 from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.kernel.rules import lemma_radius
@@ -29,6 +30,9 @@ SOS_QUERY_SECONDS = 5.0
 # the shaped V has no cheaper alternative in a `region: largest` run (a degree-8 decrease
 # condition near the excluded ball takes the interval procedure 5-20 s)
 BASIN_QUERY_SECONDS = 30.0
+# for refutations of the reach attempt's obligations (g04: its quartic V's refutations
+# took 40 s and failed; a quadratic V's are found in well under a second)
+REACH_REFUTING_SECONDS = 5.0
 BASIN_TOTAL_SHARE = 0.5  # of the run's time, at most, for the whole attempt
 BASIN_REFINEMENTS = 3  # programs solved again with the solvers' counterexamples
 BASIN_REFINING_SHARE = 0.1  # of the run's time, at most, for each
@@ -47,6 +51,11 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
         notes.append(note)
     if backend is not None and sos.applies(plan):
         found, note = _sum_of_squares(plan, backend, listener, deadline)
+        if found is not None:
+            return found
+        notes.append(note)
+    if backend is not None and sos_reach.applies(plan):
+        found, note = _reach_sum_of_squares(plan, backend, listener, deadline)
         if found is not None:
             return found
         notes.append(note)
@@ -118,6 +127,53 @@ def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
     if finding is None:
         return None, "no sum-of-squares certificate found"
     return _proved(plan, backend, listener, deadline, finding, budget)
+
+
+def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with V (and B) given and the controller set, certified outcome) or None,
+    what happened)."""
+    listener.phase(0, "sum-of-squares program (reach)")
+    budget = min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
+    finding = sos_reach.search(plan, time.monotonic() + budget)
+    if finding is None:
+        return None, "no sum-of-squares reach certificate found"
+    given = replace(plan, functions=tuple(replace(f, candidate=finding.formulas[f.name])
+                                          for f in plan.functions))
+    options = replace(given.options, query_timeout=min(given.options.query_timeout,
+                                                       SOS_QUERY_SECONDS))
+    cegis = Cegis(replace(given, options=options), backend, listener, deadline)
+    if finding.controller and not _controller_set(cegis, finding):
+        return None, f"{finding.describe()}: the controller network cannot hold its gain"
+    outcome = _refuted(given, cegis, time.monotonic() + REACH_REFUTING_SECONDS)
+    if not outcome.certified:
+        outcome = _merged(_verified_once(cegis), outcome.refutations)
+    if not outcome.certified:
+        return None, f"{finding.describe()}: not proved: {outcome.reason}"
+    return (given, replace(outcome, strategy=finding.describe())), ""
+
+
+def _controller_set(cegis: Cegis, finding) -> bool:
+    """Sets the loop's controller network to the gain the functions were found for;
+    whether its exact formulas are the ones the program used."""
+    from fossil_dsl.engine.linear import set_linear
+    controller = cegis.learner.controller
+    set_linear(controller, finding.gain, finding.operating)
+    exact = controller.formulas(cegis.states, cegis.learner.digits)
+    states = cegis.states
+    return all(sos_reach.same_polynomial(formula, finding.controller[u], states)
+               for u, formula in zip(cegis.plan.controller.inputs, exact))
+
+
+def _verified_once(cegis: Cegis) -> CegisOutcome:
+    """The loop's candidate verified as it is (nothing is learned)."""
+    candidate = cegis.exact_candidate()
+    verdicts, queries, seconds = cegis.verify(candidate, 1)
+    record = IterationRecord(1, 0.0, verdicts, 0.0, seconds)
+    cegis.listener.finished(record)
+    certified = all(v.status is Status.UNSAT for v in verdicts)
+    return CegisOutcome(certified, "every condition proved" if certified else
+                        failure_reason(verdicts), candidate, queries, tuple(verdicts),
+                        (record,), 0.0, seconds, cegis.networks)
 
 
 def _proved(plan: Plan, backend: Backend, listener, deadline: float, finding, budget: float):

@@ -12,7 +12,7 @@ import time
 
 import torch
 
-from fossil_dsl.engine import linear, reach_seed, safety_seed
+from fossil_dsl.engine import reach_seed, safety_seed, stable_seed
 from fossil_dsl.engine.evaluate import evaluate, holds, state_env
 from fossil_dsl.engine.levels import initial_samples, level_value
 from fossil_dsl.engine.loss import GUARD_BAND, condition_loss, guard_mask, placeholders
@@ -70,7 +70,8 @@ class Learner(ViolationSearch):
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V or B (and LQR controller) as the starting point
-        self.seeded = linear.seed(plan, self.networks, self.controller, self.samples) \
+        self.seeded = self.seed_from(stable_seed.candidates(plan, self.networks, self.controller,
+                                                       self.samples), least_loss=False) \
             or self.seed_from(safety_seed.candidates(plan, self.networks, self.controller,
                                                      self.samples)) \
             or self.seed_from(reach_seed.candidates(plan, self.networks, self.controller,
@@ -78,10 +79,12 @@ class Learner(ViolationSearch):
         self.parameters = [p for m in self.modules() for p in m.parameters()]
         self.optimiser = self.new_optimiser() if self.parameters else None
 
-    def seed_from(self, candidates) -> bool:
+    def seed_from(self, candidates, least_loss: bool = True) -> bool:
         """Of (preferred, set_seed) pairs, best first: the first preferred seed that meets
         every condition on the samples (with the closed loop's true field), else the first
-        other seed that does, else the one of least loss. Whether it seeded."""
+        other seed that does, else the one of least loss (or the first, where the loss
+        says little: for a discrete SWA chain the least-loss LQR gain was never
+        certified, the identity weights' in 6 s). Whether it seeded."""
         best = satisfying = None
         for preferred, set_seed in candidates:
             set_seed()
@@ -90,7 +93,7 @@ class Learner(ViolationSearch):
                 return True
             if satisfied and satisfying is None:
                 satisfying = set_seed
-            if best is None or float(loss.detach()) < best[0]:
+            if best is None or (least_loss and float(loss.detach()) < best[0]):
                 best = (float(loss.detach()), set_seed)
         chosen = satisfying or (best[1] if best is not None else None)
         if chosen is not None:

@@ -177,34 +177,6 @@ def lyapunov_matrix(A: np.ndarray, discrete: bool, decrease=None) -> np.ndarray 
     return P / eigenvalues[-1]
 
 
-def seed(plan, networks: dict[str, Network], controller: Network | None,
-         samples: dict | None = None) -> bool:
-    """Where the networks can hold them exactly, for a stable-type property: V = x^T P x
-    and the controller -K x (safety and reach-type seeds: safety_seed.py, reach_seed.py);
-    for stable while avoid, also the barrier B = x^T P x - c with c between its values
-    on the sampled I and U (a sublevel set of V is mapped into itself, so it is a
-    barrier wherever it holds I and misses U). Whether it seeded."""
-    network = networks.get("V")
-    if plan.spec.property.form not in STABLE_FORMS or network is None \
-            or not holds_a_quadratic(network, len(plan.states)):
-        return False
-    if controller is not None and not is_linear(controller, len(plan.controller.inputs)):
-        return False
-    found = local_certificate(plan.spec, controller is not None)
-    if found is None:
-        return False
-    P, K = found
-    set_quadratic(network, P)
-    if controller is not None:
-        set_linear(controller, -K)
-    barrier = networks.get("B")
-    if barrier is not None and samples and holds_a_quadratic(barrier, len(plan.states)):
-        _, level = separation(P, samples.get("barrier_initial"), samples.get("barrier_unsafe"))
-        if level is not None:
-            set_quadratic(barrier, P, level)
-    return True
-
-
 def separation(P: np.ndarray, inside, outside, floor: float | None = None,
                ceiling: float | None = None) -> tuple[float, float | None]:
     """(how many times the largest x^T P x on the sampled `inside` goes into the

@@ -189,7 +189,7 @@ class Cegis:
                 return self.outcome(state, True, "every condition proved", candidate,
                                     queries, verdicts)
             if not self.learner.trainable:
-                return self.outcome(state, False, _failure_reason(verdicts), candidate,
+                return self.outcome(state, False, failure_reason(verdicts), candidate,
                                     queries, verdicts)
             self.learn_from(verdicts)
             if _stalled(state.history[restarted:]):  # stuck where it cannot meet them
@@ -308,7 +308,7 @@ def _verdict(name: str, answer: Answer, states) -> Verdict:
     return Verdict(name, answer.status, answer.reason, point, answer.solver)
 
 
-def _failure_reason(verdicts) -> str:
+def failure_reason(verdicts) -> str:
     failed = [v for v in verdicts if v.status is not Status.UNSAT]
     words = [f"{v.condition}: {'counterexample' if v.status is Status.SAT else v.reason or 'unknown'}"
              for v in failed]

@@ -45,7 +45,7 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
         for mu in DECAY_RATES:
             if time.monotonic() > deadline:
                 return None
-            program = _BarrierProgram(len(states), field, initial, unsafe, domain, degree, mu)
+            program = BarrierProgram(len(states), field, initial, [unsafe], domain, degree, mu)
             if program.count > MAX_VARIABLES:
                 return None
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
@@ -59,8 +59,11 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
     return None
 
 
-class _BarrierProgram(Program):
-    def __init__(self, n: int, field, initial, unsafe, domain, degree: int, mu: float):
+class BarrierProgram(Program):
+    """The identities above; U given as pieces (constraint lists), B > 0 on each."""
+
+    def __init__(self, n: int, field, initial, unsafe_pieces, domain, degree: int,
+                 mu: float):
         super().__init__(n)
         self.basis = P.monomials(n, 0, 2 * degree)
         self.coefficients = [self.scalar() for _ in self.basis]
@@ -71,7 +74,8 @@ class _BarrierProgram(Program):
         b_terms = [{m: Fraction(1)} for m in self.basis]
         self._condition([(v, P.scale(t, -1)) for v, t in zip(self.coefficients, b_terms)],
                         initial)
-        self._condition(list(zip(self.coefficients, b_terms)), unsafe)
+        for piece in unsafe_pieces:
+            self._condition(list(zip(self.coefficients, b_terms)), piece)
         flow = [(v, P.add(P.scale(P.lie_derivative(t, field), -1), P.scale(t, -mu)))
                 for v, t in zip(self.coefficients, b_terms)]
         self._condition(flow, domain)

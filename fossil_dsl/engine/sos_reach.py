@@ -1,0 +1,272 @@
+"""A sum-of-squares attempt for reach-type properties (reach, RWA, RAR) of a polynomial
+ODE; where the system has inputs, with a linear controller fixed beforehand to an LQR
+gain of its linearisation, rounded as the verifier will see it.
+
+V (a polynomial of degree 2 or 4, coefficients in [-100, 100]) and the largest e with
+
+    -V - e          >= 0  on I
+     V - e          >= 0  on each face of D, and on D outside the interior of S
+    -dV/dt - γ - e  >= 0  on D outside the interior of G
+
+each a Positivstellensatz identity (a sum of squares plus sum-of-squares multiples of the
+set's constraints; "outside a set's interior" is one piece per constraint g >= 0 of the
+set, where g <= 0). The last asks dV/dt <= -γ even where V > 0, which is stronger than the
+condition but keeps the program linear in V; V's sublevel set {V <= 0} may lie anywhere,
+so it need not be centred at the origin (an I on one side of G, an unsafe set on the
+other: no ellipsoid round the origin fits between them). For RAR, B comes from the barrier
+program (sos_barrier.py) with G for I and the part of D outside F for U.
+
+Nothing here is trusted: the functions are rounded and proved like any candidate.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir import traversal
+from fossil_dsl.ir.sets import Complement, Intersection
+from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.plan.certificates.rwa import GAMMA
+from fossil_dsl.plan.compile import Plan
+from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
+from fossil_dsl.solvers.sdp import Program
+from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
+
+FORMS = ("reach while avoid", "reach", "reach-avoid-remain")
+HALF_DEGREES = (1, 2)  # V of degree 2, then 4
+DECIMALS = 6  # kept of V's coefficients
+MIN_MARGIN = 1e-6
+# |coefficient| of V at most this: γ is absolute, so V must be free to be steep (a
+# quadratic that holds I far out and decreases by γ at G's edge needs entries above 1)
+BOUND = 100.0
+
+
+@dataclass(frozen=True)
+class ReachFinding:
+    """V (and B for RAR) as exact formulas, and the controller they were found for
+    (input -> exact formula; empty without inputs)."""
+
+    formulas: dict
+    controller: dict
+    gain: np.ndarray | None  # -K, u = -K x + operating point
+    operating: np.ndarray
+    degree: int
+    margin: float
+    seconds: float
+
+    def describe(self) -> str:
+        control = " for an LQR gain of the linearisation" if self.controller else ""
+        return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}"
+                f"{' and a quadratic B' if 'B' in self.formulas else ''}{control}, "
+                f"margin {self.margin:.3g}, {self.seconds:.2f} s")
+
+
+def applies(plan: Plan) -> bool:
+    """A polynomial ODE, a reach-type property, the default templates, and at most a
+    linear controller (the default one)."""
+    spec = plan.spec
+    linear_controller = plan.controller is None or (
+        all(layer.activation == "linear" for layer in plan.controller.layers)
+        and spec.synthesis.controller is None)
+    return (plan.certificate.form in FORMS and spec.time is TimeDomain.CONTINUOUS
+            and linear_controller and spec.torch_dynamics is None
+            and spec.synthesis.certificate is None and spec.synthesis.certificate2 is None
+            and spec.synthesis.candidate is None and not plan.options.learn_only
+            and _polynomial(spec.dynamics, spec.states + spec.inputs) is not None)
+
+
+def search(plan: Plan, deadline: float) -> ReachFinding | None:
+    """The first V (and B) found, over the controllers tried and V's degrees."""
+    from fossil_dsl.engine.linear import operating_point  # imports torch
+    started = time.monotonic()
+    spec, states = plan.spec, plan.states
+    operating = operating_point(spec) if spec.inputs else np.zeros(0)
+    if operating is None:
+        return None
+    try:
+        pieces = _Pieces(plan)
+    except Inexact:
+        return None
+    rng = np.random.default_rng(plan.options.seed)
+    for controller, gain in _controllers(plan, operating, rng):
+        field = _polynomial([traversal.substitute(f, controller) for f in spec.dynamics],
+                            states)
+        if field is None or time.monotonic() > deadline:
+            continue
+        found = _functions(len(states), field, pieces, deadline)
+        if found is not None:
+            formulas, degree, margin = found
+            return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
+                                controller, gain, operating, degree, margin,
+                                time.monotonic() - started)
+    return None
+
+
+def _controllers(plan: Plan, operating: np.ndarray, rng):
+    """(input -> exact formula, -K) for each LQR gain (rounded to the digits the
+    verifier sees), or one ({}, None) without inputs."""
+    from fossil_dsl.engine.quadratic_shapes import lqr_gains
+    spec = plan.spec
+    if not spec.inputs:
+        yield {}, None
+        return
+    digits = plan.options.digits
+    for _, K in lqr_gains(spec, True, operating, rng):
+        gain = np.round(-K, digits)
+        bias = np.round(operating, digits)
+        yield {u: E.add(*(E.mul(E.Num(_exact(w)), E.Var(s)) for w, s in zip(row, spec.states)),
+                        E.Num(_exact(b)))
+               for u, row, b in zip(spec.inputs, gain, bias)}, gain
+
+
+def _exact(value: float) -> Fraction:
+    return Fraction(str(float(value)))
+
+
+def same_polynomial(first: E.Expr, second: E.Expr, states) -> bool:
+    found = _polynomial([first, second], states)
+    return found is not None and found[0] == found[1]
+
+
+def _polynomial(expressions, variables):
+    try:
+        return [P.polynomial(f, variables) for f in expressions]
+    except P.NotPolynomial:
+        return None
+
+
+def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:
+    """The constraints, and the product of each pair of opposite linear bounds (l <= x_i
+    and x_i <= u give (x_i - l)(u - x_i) >= 0): without them a box's multipliers of low
+    degree cannot see that it is bounded, and the programs for lit17's sets are
+    infeasible."""
+    linear = [g for g in constraints if P.degree(g) == 1]
+    products = [P.multiply(g, h) for i, g in enumerate(linear) for h in linear[i + 1:]
+                if P.degree(P.add(g, h)) < 1]
+    return constraints + products
+
+
+class Inexact(ValueError):
+    """A set whose membership is not a conjunction of polynomial comparisons (a union, a
+    complement): the programs would ask for their conditions on the wrong set."""
+
+
+def constraints_of(region, states) -> list[P.Polynomial]:
+    """g_1, ..., g_k with the region = {every g_i >= 0} (closures of strict ones)."""
+    found = []
+    for atom in conjuncts(region.contains_formula(states)):
+        try:
+            found += [h for h, _ in comparisons(atom, states)]
+        except ValueError as exc:  # not a comparison, or not polynomial
+            raise Inexact(str(exc)) from exc
+    return found
+
+
+class _Pieces:
+    """The constraint lists (g >= 0 on the piece) of every condition's sets; raises
+    Inexact where a set is not described exactly."""
+
+    def __init__(self, plan: Plan):
+        spec, states = plan.spec, plan.states
+        prop = spec.property
+        self.domain = constraints_of(spec.domain, states)
+        self.initial = interval_products(constraints_of(prop.role("initial"), states))
+        unsafe = prop.role("unsafe")
+        if prop.form == "reach":  # S is D
+            outside_safe = []
+        elif unsafe is not None and not isinstance(unsafe, Complement):  # S = D \ U
+            outside_safe = [interval_products(
+                constraints_of(Intersection(unsafe, spec.domain), states))]
+        else:  # S is a set of its own (`S until G`)
+            outside_safe = self.outside(prop.role("safe"), states)
+        self.boundary = self.faces() + outside_safe
+        self.outside_goal = self.outside(prop.role("goal"), states)
+        self.goal = interval_products(constraints_of(prop.role("goal"), states))
+        final = prop.role("final")
+        self.outside_final = self.outside(final, states) if final is not None else None
+
+    def faces(self) -> list[list[P.Polynomial]]:
+        """Each face {g = 0} of the domain, within the domain."""
+        return [[g, P.scale(g, -1)] + interval_products(self.domain[:k] + self.domain[k + 1:])
+                for k, g in enumerate(self.domain)]
+
+    def outside(self, region, states) -> list[list[P.Polynomial]]:
+        """D outside the region's interior: {g <= 0} within D, one piece per g."""
+        return [[P.scale(g, -1)] + interval_products(self.domain)
+                for g in constraints_of(region, states)]
+
+
+def _functions(n: int, field, pieces: _Pieces, deadline: float):
+    """({"V": V, "B": B for RAR}, V's degree, margin) or None."""
+    b = None
+    if pieces.outside_final is not None:
+        b = _barrier(n, field, pieces, deadline)
+        if b is None:
+            return None
+    for half in HALF_DEGREES:
+        if time.monotonic() > deadline:
+            return None
+        program = _ReachProgram(n, field, pieces, half)
+        if program.count > MAX_VARIABLES:
+            return None
+        x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
+        if x is not None and x[program.margin] > MIN_MARGIN:
+            found = {"V": program.exact_v(x)}
+            if b is not None:
+                found["B"] = b
+            return found, 2 * half, float(x[program.margin])
+    return None
+
+
+def _barrier(n: int, field, pieces: _Pieces, deadline: float):
+    """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B on D; or None."""
+    for mu in DECAY_RATES:
+        if time.monotonic() > deadline:
+            return None
+        program = BarrierProgram(n, field, pieces.goal, pieces.outside_final, pieces.domain,
+                                 1, mu)
+        x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
+        if x is not None and x[program.margin] > MIN_MARGIN:
+            return program.exact_b(x)
+    return None
+
+
+class _ReachProgram(Program):
+    def __init__(self, n: int, field, pieces: _Pieces, half: int):
+        super().__init__(n)
+        self.basis = P.monomials(n, 0, 2 * half)
+        self.coefficients = [self.scalar() for _ in self.basis]
+        for variable in self.coefficients:
+            self.at_most += [({variable: 1.0}, BOUND), ({variable: -1.0}, BOUND)]
+        self.margin = self.scalar()
+        self.at_most.append(({self.margin: 1.0}, 1.0))
+        terms = [{m: Fraction(1)} for m in self.basis]
+        negated = [(v, P.scale(t, -1)) for v, t in zip(self.coefficients, terms)]
+        self.require(negated, pieces.initial)
+        for piece in pieces.boundary:
+            self.require(list(zip(self.coefficients, terms)), piece)
+        decrease = [(v, P.scale(P.lie_derivative(t, field), -1))
+                    for v, t in zip(self.coefficients, terms)]
+        for piece in pieces.outside_goal:
+            self.require(decrease, piece, P.constant(-GAMMA, n))
+
+    def require(self, terms, constraints, constant=None) -> None:
+        """sum of terms (+ constant) - e = s + sum_i sigma_i g_i, as one identity."""
+        for variable, polynomial in terms:
+            self.add_term(variable, polynomial)
+        if constant:
+            self.add_constant(constant)
+        self.add_term(self.margin, P.constant(-1, self.n))
+        top = max([2] + [P.degree(p) for _, p in terms] + [P.degree(g) for g in constraints])
+        self.minus_certificate((top + 1) // 2, constraints, low=0)
+        self.new_identity()
+
+    def exact_v(self, x) -> P.Polynomial:
+        return P.add(*({m: decimal(x[v], DECIMALS)} for m, v in zip(self.basis,
+                                                                   self.coefficients)))

@@ -1,0 +1,54 @@
+"""The seed for stable-type properties (stability, ROA, SWA): the linearisation's quadratic
+Lyapunov function and, with inputs, its LQR gain, for several LQR weightings
+(safety and reach-type seeds: safety_seed.py, reach_seed.py). Nothing here is trusted: a
+seed is rounded and verified like any candidate."""
+from __future__ import annotations
+
+import numpy as np
+
+from fossil_dsl.engine.linear import (STABLE_FORMS, holds_a_quadratic, is_linear,
+                                      lyapunov_matrix, separation, set_linear, set_quadratic)
+from fossil_dsl.engine.networks import Network
+from fossil_dsl.engine.quadratic_shapes import lqr_gains
+from fossil_dsl.ir.spec import TimeDomain
+
+
+def candidates(plan, networks: dict[str, Network], controller: Network | None,
+               samples: dict | None = None) -> list:
+    """Seeds for a stable-type property where the networks can hold them exactly, as
+    (preferred, set_seed) pairs for Learner.seed_from: V = x^T P x and the controller
+    -K x, for the LQR gain with identity weights first and then the reach seeds' random
+    weightings (with a controller: the identity weights' gain can leave I outside every
+    sublevel set on which V decreases, as for the Moore-Greitzer model, where others
+    do not); for stable while avoid, also the barrier B = x^T P x - c with c between its
+    values on the sampled I and U (a sublevel set of V is mapped into itself, so it is a
+    barrier wherever it holds I and misses U). Safety and reach-type seeds:
+    safety_seed.py, reach_seed.py."""
+    network = networks.get("V")
+    if plan.spec.property.form not in STABLE_FORMS or network is None \
+            or not holds_a_quadratic(network, len(plan.states)):
+        return []
+    if controller is not None and not is_linear(controller, len(plan.controller.inputs)):
+        return []
+    discrete = plan.spec.time is TimeDomain.DISCRETE
+    found = []
+    rng = np.random.default_rng(plan.options.seed)
+    for A, K in lqr_gains(plan.spec, controller is not None, None, rng):
+        P = lyapunov_matrix(A, discrete)
+        if P is not None:
+            found.append((True, _quadratic_setter(networks, controller, samples, P, K)))
+    return found
+
+
+def _quadratic_setter(networks, controller, samples, P: np.ndarray, K):
+    def set_seed() -> None:
+        set_quadratic(networks["V"], P)
+        if controller is not None:
+            set_linear(controller, -K)
+        barrier = networks.get("B")
+        if barrier is not None and samples and holds_a_quadratic(barrier, len(P)):
+            _, level = separation(P, samples.get("barrier_initial"),
+                                  samples.get("barrier_unsafe"))
+            if level is not None:
+                set_quadratic(barrier, P, level)
+    return set_seed

@@ -1,0 +1,123 @@
+"""The sum-of-squares attempt for reach-type properties (engine/sos_reach.py): V (and B)
+from a semidefinite program, with a controller fixed to an LQR gain where there are
+inputs, proved like any candidate."""
+import sympy
+
+import fossil_dsl
+from fossil_dsl.engine import sos_reach
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.plan.compile import compile_spec
+
+# I on the left, the unsafe box on the right, both further from the origin than G: every
+# ellipsoid round the origin that holds I reaches x0 = 1.5 > 1.2 (I is symmetric to a set
+# that meets U), so no quadratic V centred at the origin can certify it
+DOUBLE_INTEGRATOR_RAR = """\
+state x0, x1
+input u0
+dynamics continuous {
+    x0' = x1
+    x1' = u0
+}
+domain box([-2, -2], [2, 2])
+set init   = box([-1.5, -0.2], [-1.2, 0.2])
+set goal   = ball([0, 0], 0.2)
+set final  = ball([0, 0], 0.6)
+set unsafe = box([1.2, -2], [2, 2])
+prove from init: not unsafe until (goal and always final)
+"""
+
+# false: x' = -x runs straight from I through U to G
+STRAIGHT_THROUGH = """\
+state x0, x1
+dynamics continuous {
+    x0' = -x0
+    x1' = -x1
+}
+domain box([-2, -2], [2, 2])
+set init = box([1.7, -0.05], [1.9, 0.05])
+set goal = ball([0, 0], 0.2)
+set unsafe = box([0.8, -0.3], [1.2, 0.3])
+prove from init: not unsafe until goal
+"""
+
+
+def test_reach_avoid_remain_with_a_controller_is_certified_by_the_program():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(DOUBLE_INTEGRATOR_RAR), timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+    assert result.learn_seconds < 0.01
+    V = result.sympy["V"]
+    x0, x1 = sorted(V.free_symbols, key=str)
+    # V <= 0 on I but V > 0 on I's mirror image (which meets U): not centred at 0
+    assert float(V.subs({x0: -1.35, x1: 0})) <= 0 < float(V.subs({x0: 1.35, x1: 0}))
+    # the controller verified is the linear one the program was solved for
+    k = sympy.Poly(result.sympy["u0"], x0, x1)
+    assert k.total_degree() == 1 and all(c < 0 for c in k.coeffs()[:2])
+
+
+def test_the_program_finds_nothing_for_a_false_reach_property():
+    plan = compile_spec(fossil_dsl.loads(STRAIGHT_THROUGH))
+    assert sos_reach.applies(plan)
+    import time
+    assert sos_reach.search(plan, time.monotonic() + 30) is None
+    result = fossil_dsl.synthesise(fossil_dsl.loads(STRAIGHT_THROUGH), timeout=30,
+                                   max_iters=2)
+    assert not result.certified and not result.kernel.certified
+
+
+def test_a_box_gets_the_products_of_its_opposite_bounds_only():
+    x = {(1, 0): 1}
+    lower, upper = P.add(x, P.constant(1, 2)), P.add(P.scale(x, -1), P.constant(2, 2))
+    other = {(0, 1): 1}
+    found = sos_reach.interval_products([lower, upper, other])
+    assert found[:3] == [lower, upper, other] and len(found) == 4
+    product = found[3]
+    # (x + 1)(2 - x) >= 0 exactly on [-1, 2]
+    at = lambda v: sum(float(c) * v ** m[0] for m, c in product.items())
+    assert at(-1) == at(2) == 0 and at(0.5) > 0 and at(3) < 0
+
+
+def test_user_templates_and_nonlinear_controllers_are_left_to_learning():
+    templated = DOUBLE_INTEGRATOR_RAR + "synthesis {\n    certificate: tanh(6)\n}\n"
+    assert not sos_reach.applies(compile_spec(fossil_dsl.loads(templated)))
+    controller = DOUBLE_INTEGRATOR_RAR + "synthesis {\n    controller: tanh(4)\n}\n"
+    assert not sos_reach.applies(compile_spec(fossil_dsl.loads(controller)))
+    assert sos_reach.applies(compile_spec(fossil_dsl.loads(DOUBLE_INTEGRATOR_RAR)))
+
+
+SAFE_UNTIL_GOAL = """\
+state x0, x1
+input u0
+dynamics continuous {
+    x0' = x1
+    x1' = u0
+}
+domain box([-2.5, -2.5], [2.5, 2.5])
+set safe = box([-2, -2], [2, 2])
+set init = box([0.5, -0.1], [0.7, 0.1])
+set goal = box([-0.2, -0.2], [0.2, 0.2])
+prove from init: safe until goal
+"""
+
+
+def test_a_safe_set_of_its_own_is_left_by_its_own_faces():
+    """`S until G`: the unsafe role is the complement of S, which is no conjunction; V > 0
+    is asked for outside S (one piece per bound of S), not on all of D (infeasible)."""
+    import time
+    plan = compile_spec(fossil_dsl.loads(SAFE_UNTIL_GOAL))
+    found = sos_reach.search(plan, time.monotonic() + 30)
+    assert found is not None and found.degree == 2
+    result = fossil_dsl.synthesise(fossil_dsl.loads(SAFE_UNTIL_GOAL), timeout=60)
+    assert result.certified and result.strategy.startswith("sum-of-squares"), result.summary()
+
+
+def test_a_set_that_is_no_conjunction_gives_no_program():
+    """A union of boxes for U: its constraints cannot be listed as one piece, and a
+    program over a wrong set would only waste the run's time."""
+    import time
+    union = DOUBLE_INTEGRATOR_RAR.replace("set unsafe = box([1.2, -2], [2, 2])",
+                                          "set unsafe = box([1.2, -2], [2, 2]) | "
+                                          "box([-2, 1.5], [2, 2])")
+    plan = compile_spec(fossil_dsl.loads(union))
+    assert sos_reach.applies(plan)
+    assert sos_reach.search(plan, time.monotonic() + 30) is None
