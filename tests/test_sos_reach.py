@@ -121,3 +121,36 @@ def test_a_set_that_is_no_conjunction_gives_no_program():
     plan = compile_spec(fossil_dsl.loads(union))
     assert sos_reach.applies(plan)
     assert sos_reach.search(plan, time.monotonic() + 30) is None
+
+
+GIVEN_RAR = """\
+state x0, x1
+dynamics continuous {
+    x0' = -x0
+    x1' = -x1
+}
+domain box([-2, -2], [2, 2])
+set init   = box([-1.3, -0.1], [-1.1, 0.1])
+set goal   = ball([0, 0], 0.2)
+set final  = FINAL
+set unsafe = box([1.8, -2], [2, 2])
+prove from init: not unsafe until (goal and always final)
+synthesis {
+    candidate:  x0^2 + x1^2 - 5/2
+    candidate2: x0^2 + x1^2 - 1/4
+}
+"""
+
+
+def test_remaining_in_f_for_ever_needs_f_inside_the_interior_of_d():
+    """B > 0 on D \\ F and F (closed) in the interior of D: a trajectory must cross B = 0
+    inside D before it can leave F, so the qualifier "while it stays in D" goes; where F
+    reaches the boundary of D it stays (the base guarantee is certified either way)."""
+    inside = fossil_dsl.synthesise(fossil_dsl.loads(
+        GIVEN_RAR.replace("FINAL", "box([-0.6, -0.6], [0.6, 0.6])")), timeout=60)
+    assert inside.certified and inside.kernel.strengthened == "remains in F"
+    assert "remains in F for ever" in inside.guarantee()
+    touching = fossil_dsl.synthesise(fossil_dsl.loads(
+        GIVEN_RAR.replace("FINAL", "box([-2, -0.6], [0.6, 0.6])")), timeout=60)
+    assert touching.certified and touching.kernel.strengthened is None
+    assert "while it stays in D" in touching.guarantee()

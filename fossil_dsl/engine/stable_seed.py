@@ -14,7 +14,7 @@ from fossil_dsl.ir.spec import TimeDomain
 
 
 def candidates(plan, networks: dict[str, Network], controller: Network | None,
-               samples: dict | None = None) -> list:
+               samples: dict | None = None):
     """Seeds for a stable-type property where the networks can hold them exactly, as
     (preferred, set_seed) pairs for Learner.seed_from: V = x^T P x and the controller
     -K x, for the LQR gain with identity weights first and then the reach seeds' random
@@ -30,14 +30,17 @@ def candidates(plan, networks: dict[str, Network], controller: Network | None,
         return []
     if controller is not None and not is_linear(controller, len(plan.controller.inputs)):
         return []
+    return _seeds(plan, networks, controller, samples)
+
+
+def _seeds(plan, networks, controller, samples):
+    """One at a time: the weightings after the first are solved only when it fails."""
     discrete = plan.spec.time is TimeDomain.DISCRETE
-    found = []
     rng = np.random.default_rng(plan.options.seed)
     for A, K in lqr_gains(plan.spec, controller is not None, None, rng):
         P = lyapunov_matrix(A, discrete)
         if P is not None:
-            found.append((True, _quadratic_setter(networks, controller, samples, P, K)))
-    return found
+            yield True, _quadratic_setter(networks, controller, samples, P, K)
 
 
 def _quadratic_setter(networks, controller, samples, P: np.ndarray, K):

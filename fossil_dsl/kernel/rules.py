@@ -327,3 +327,12 @@ def reach_avoid_remain(facts: Facts) -> None:
     facts.disjoint("relation:final and unsafe", "F and U are disjoint", final,
                    facts.member(facts.role("unsafe")))
     barrier_conditions(facts, "B", goal, L.negation(final), "G", "D \\ F", prefix="barrier_")
+
+
+@strengthening("reach-avoid-remain", CONTINUOUS, name="remains in F", guarantee=reach_guarantee(
+    "S", "G") + "; once in G, it remains in F for ever: B <= 0 on G, B > 0 on D \\ F, B "
+    "strictly decreases wherever B = 0 in D, and F's closure lies in the interior of D, so "
+    "a trajectory would have to cross B = 0 in D before it could leave F")
+def remains_in_final(facts: Facts) -> None:
+    facts.inside("strong:final in interior of domain", "the closure of F lies in the interior "
+                 "of D", facts.closure(facts.role("final")), facts.interior(facts.spec.domain))
