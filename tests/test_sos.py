@@ -274,3 +274,39 @@ def test_the_learning_loop_tries_refutations_first_from_six_states():
     assert result.certified and result.iterations == 1, result.reason
     solvers = {c.name: c.solver for c in result.conditions}
     assert solvers["positive"] == solvers["decrease"] == "sum of squares (exact)", solvers
+
+
+CUBIC_MAP = """\
+state x0, x1, x2, x3
+dynamics discrete {
+    next(x0) = 0.5*x0 + 0.2*x1 - 0.1*x0^3
+    next(x1) = -0.2*x0 + 0.5*x1 - 0.1*x1^3
+    next(x2) = 0.6*x2 + 0.1*x3
+    next(x3) = 0.1*x0 + 0.6*x3 - 0.1*x3^3
+}
+domain box([-1, -1, -1, -1], [1, 1, 1, 1])
+prove stable
+"""
+
+
+def test_a_box_domain_gets_its_bound_products_where_the_bounds_alone_give_nothing():
+    """V(f(x)) - V(x) of a cubic map has terms -c x_i^6 that sum-of-squares multiples of
+    the linear bounds (degree 5 at most) cannot match; (1 - x_i^2) times a quartic can."""
+    plan = _plan(CUBIC_MAP)
+    field = sos.field_of(plan)
+    plain = sos.set_constraints(plan.spec.domain, plan.states)
+    program = sos._LyapunovProgram(4, field, plain, 1, 1, True)
+    assert program.solve({program.margin: -1.0}, 60) is None  # infeasible
+    found = sos.lyapunov(plan, time.monotonic() + 60)
+    assert found is not None and found.margin > 0.01
+
+
+def test_a_map_whose_decrease_z3_cannot_decide_is_proved_outside_a_lemma_ball():
+    """Z3 times out on the sextic decrease and the interval procedure cannot refute boxes
+    at the origin: the V is proved with a ball the Taylor lemma covers, and the guarantee
+    is still asymptotic stability (no ε)."""
+    result = fossil_dsl.synthesise(fossil_dsl.loads(CUBIC_MAP), timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming")
+    assert "asymptotically stable" in result.guarantee()
+    assert "ε" not in result.guarantee() and "epsilon" not in result.guarantee()

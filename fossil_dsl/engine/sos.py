@@ -70,27 +70,36 @@ def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
     """The first V (by degree) whose program is feasible with a positive margin, or None."""
     started = time.monotonic()
     field = field_of(plan)
-    constraints = set_constraints(plan.spec.domain, plan.states)
-    for degree, power in ((d, m) for d in DEGREES for m in MARGIN_POWERS):
-        if time.monotonic() > deadline:
-            return None
-        program = _LyapunovProgram(len(plan.states), field, constraints, degree, power,
-                                   plan.spec.time is TimeDomain.DISCRETE)
-        if program.count > MAX_VARIABLES:
-            return None
-        x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
-        if x is None or x[program.margin] <= MIN_MARGIN:
-            continue
-        if plan.certificate.form in ROA_FORMS:
-            rounder = _roundest(program, float(x[program.margin]), deadline)
-            x = rounder if rounder is not None else x
-        formula = P.to_expr(program.exact_v(x), plan.states)
-        margin = float(x[program.margin])
-        change = "V(f(x)) - V(x)" if program.discrete else "dV/dt"
-        return SosFinding(formula, "V", 2 * degree, margin,
-                          f"{change} <= -{margin:.3g} |x|^{2 * power} on D",
-                          time.monotonic() - started)
+    plain = set_constraints(plan.spec.domain, plan.states)
+    # with a box's products only where the plain constraints give nothing: the programs
+    # grow, and what was found before stays as it was
+    variants = (plain,) if interval_products(plain) == plain else \
+        (plain, interval_products(plain))
+    for constraints in variants:
+        for degree, power in ((d, m) for d in DEGREES for m in MARGIN_POWERS):
+            if time.monotonic() > deadline:
+                return None
+            program = _LyapunovProgram(len(plan.states), field, constraints, degree, power,
+                                       plan.spec.time is TimeDomain.DISCRETE)
+            if program.count > MAX_VARIABLES:
+                break
+            x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
+            if x is not None and x[program.margin] > MIN_MARGIN:
+                return _finding(plan, program, x, degree, power, deadline, started)
     return None
+
+
+def _finding(plan: Plan, program: "_LyapunovProgram", x, degree: int, power: int,
+             deadline: float, started: float) -> SosFinding:
+    if plan.certificate.form in ROA_FORMS:
+        rounder = _roundest(program, float(x[program.margin]), deadline)
+        x = rounder if rounder is not None else x
+    formula = P.to_expr(program.exact_v(x), plan.states)
+    margin = float(x[program.margin])
+    change = "V(f(x)) - V(x)" if program.discrete else "dV/dt"
+    return SosFinding(formula, "V", 2 * degree, margin,
+                      f"{change} <= -{margin:.3g} |x|^{2 * power} on D",
+                      time.monotonic() - started)
 
 
 def _roundest(program: "_LyapunovProgram", margin: float, deadline: float):
@@ -120,6 +129,18 @@ def set_constraints(region, states) -> list[P.Polynomial]:
         except ValueError:
             continue
     return found
+
+
+def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:
+    """The constraints, and the product of each pair of opposite linear bounds (l <= x_i
+    and x_i <= u give (x_i - l)(u - x_i) >= 0): without them a box's multipliers of low
+    degree cannot see that it is bounded: the reach program for lit17's sets, and the
+    Lyapunov program for a 4-state cubic map (whose V(f(x)) - V(x) has terms -x_i^6 that
+    only (1 - x_i^2) times a quartic can match), are infeasible."""
+    linear = [g for g in constraints if P.degree(g) == 1]
+    products = [P.multiply(g, h) for i, g in enumerate(linear) for h in linear[i + 1:]
+                if P.degree(P.add(g, h)) < 1]
+    return constraints + products
 
 
 class _LyapunovProgram(Program):

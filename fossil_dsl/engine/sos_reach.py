@@ -26,6 +26,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from fossil_dsl.engine.sos import interval_products
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
@@ -139,17 +140,6 @@ def _polynomial(expressions, variables):
         return [P.polynomial(f, variables) for f in expressions]
     except P.NotPolynomial:
         return None
-
-
-def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:
-    """The constraints, and the product of each pair of opposite linear bounds (l <= x_i
-    and x_i <= u give (x_i - l)(u - x_i) >= 0): without them a box's multipliers of low
-    degree cannot see that it is bounded, and the programs for lit17's sets are
-    infeasible."""
-    linear = [g for g in constraints if P.degree(g) == 1]
-    products = [P.multiply(g, h) for i, g in enumerate(linear) for h in linear[i + 1:]
-                if P.degree(P.add(g, h)) < 1]
-    return constraints + products
 
 
 class Inexact(ValueError):
