@@ -1,6 +1,11 @@
 """BarrierBench problems as .fsl specs.
 
     python benchmarks/barrierbench_specs.py ../shared/barrierbench-dev.json specs/barrierbench
+    python benchmarks/barrierbench_specs.py benchmarks/data/barrierbench-unsolved.json \
+        specs/barrierbench-unsolved unsolved_problems bbu
+
+The second: BarrierBench's problems published without a barrier (no method has solved
+them), kept in benchmarks/data/.
 
 BarrierBench (L4DC 2026) states dynamics, an initial set and an unsafe set, and no
 domain: its claims are global ("never enter U"). A spec needs a bounded domain, chosen
@@ -41,10 +46,16 @@ def vector(values) -> str:
 
 
 def set_text(region: dict) -> str:
+    text = _plain_set_text(region)
+    if not region.get("complement"):
+        return text
+    return f"~({text})" if region["type"] == "union" else f"~{text}"
+
+
+def _plain_set_text(region: dict) -> str:
     kind = region["type"]
     if kind == "ball":
-        text = f"ball({vector(region['center'])}, {format(float(region['radius']), 'g')})"
-        return f"~{text}" if region.get("complement") else text
+        return f"ball({vector(region['center'])}, {format(float(region['radius']), 'g')})"
     if kind in ("box", "bounds"):
         lows, highs = zip(*region["bounds"])
         return f"box({vector(lows)}, {vector(highs)})"
@@ -78,12 +89,12 @@ def domain_text(problem: dict, n: int) -> str:
            f"{vector(h + m for h, m in zip(high, margin))})"
 
 
-def spec_text(name: str, entry: dict) -> str:
+def spec_text(name: str, entry: dict, part: str = "dev half") -> str:
     problem = entry["problem"]
     time, found = equations(problem["dynamics"])
     states = [s for s, _ in found]
     inputs = [u.strip() for u in problem.get("controller_parameters", "").split(",") if u.strip()]
-    lines = [f"# BarrierBench (L4DC 2026), dev half: {name}.",
+    lines = [f"# BarrierBench (L4DC 2026), {part}: {name}.",
              f"# Published barrier: {entry.get('barrier', '?')}"]
     if entry.get("controllers"):
         lines.append(f"# Published controller: {entry['controllers']}")
@@ -100,15 +111,16 @@ def spec_text(name: str, entry: dict) -> str:
     return "\n".join(lines)
 
 
-def main(source: str, target: str) -> None:
-    problems = json.loads(Path(source).read_text())["solved_problems"]
+def main(source: str, target: str, key: str = "solved_problems", prefix: str = "bb") -> None:
+    problems = json.loads(Path(source).read_text())[key]
+    part = "dev half" if key == "solved_problems" else key.replace("_", " ")
     out = Path(target)
     out.mkdir(parents=True, exist_ok=True)
     for index, entry in enumerate(problems):
-        name = f"bb{index:02d}"
-        (out / f"{name}.fsl").write_text(spec_text(name, entry))
+        name = f"{prefix}{index:02d}"
+        (out / f"{name}.fsl").write_text(spec_text(name, entry, part))
     print(f"{len(problems)} specs written to {out}")
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:3])
+    main(*sys.argv[1:5])

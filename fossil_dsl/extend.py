@@ -15,7 +15,7 @@ from fossil_dsl.check.properties import PropertyForm, register_form
 from fossil_dsl.ir import expr, logic, sets
 from fossil_dsl.ir.spec import Layer
 from fossil_dsl.kernel.obligations import Facts
-from fossil_dsl.kernel.obligations import rule as kernel_rule
+from fossil_dsl.kernel.registry import rule as kernel_rule
 
 __all__ = ["Certificate", "Condition", "Facts", "LearnedFunction", "Layer", "Level",
            "PropertyForm", "kernel_rule",

@@ -18,7 +18,8 @@ from fossil_dsl.engine.evaluate import evaluate, holds
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.kernel import judge
-from fossil_dsl.kernel.obligations import RULES, Claim, Facts, common
+from fossil_dsl.kernel.obligations import Claim, Facts, common
+from fossil_dsl.kernel.registry import RULES
 from fossil_dsl.kernel.prove import Outcome
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.base import CERTIFICATES

@@ -16,7 +16,7 @@ import fossil_dsl
 from fossil_dsl.plan.certificates import base as certificate_registry
 from fossil_dsl.check import properties
 from fossil_dsl.kernel import guarantee_text
-from fossil_dsl.kernel import obligations as kernel_obligations
+from fossil_dsl.kernel import registry as kernel_obligations
 from fossil_dsl.plan.compile import compile_spec
 from fossil_dsl.outputs.result import write_artefacts
 from fossil_dsl.solvers.api import Status

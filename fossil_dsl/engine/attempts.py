@@ -9,14 +9,15 @@ import time
 import numpy as np
 from dataclasses import replace
 
-from fossil_dsl.engine import basin, sos, sos_reach
+from fossil_dsl.engine import basin, first_integral, sos, sos_reach
+from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import (Cegis, CegisOutcome, IterationRecord, Verdict, as_listener,
                                     failure_reason)
 from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.kernel.rules import lemma_radius
-from fossil_dsl.plan.compile import Plan, origin_radius
+from fossil_dsl.plan.compile import Plan, origin_radius, with_conditions
 from fossil_dsl.solvers.api import Backend, Status
 from fossil_dsl.solvers.sos_refutation import refute
 
@@ -33,6 +34,7 @@ BASIN_QUERY_SECONDS = 30.0
 # for refutations of the reach attempt's obligations (g04: its quartic V's refutations
 # took 40 s and failed; a quadratic V's are found in well under a second)
 REACH_REFUTING_SECONDS = 5.0
+CONSERVED_REFINEMENTS = 3  # conserved-quantity barriers chosen again with counterexamples
 BASIN_TOTAL_SHARE = 0.5  # of the run's time, at most, for the whole attempt
 BASIN_REFINEMENTS = 3  # programs solved again with the solvers' counterexamples
 BASIN_REFINING_SHARE = 0.1  # of the run's time, at most, for each
@@ -49,6 +51,11 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
         if found is not None:
             return found
         notes.append(note)
+    if backend is not None and first_integral.applies(plan):
+        found, note = _conserved(plan, backend, listener, deadline)
+        if found is not None:
+            return found
+        notes.append(note)
     if backend is not None and sos.applies(plan):
         found, note = _sum_of_squares(plan, backend, listener, deadline)
         if found is not None:
@@ -61,7 +68,18 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
         notes.append(note)
     note = "; ".join(n for n in notes if n)
     outcome = Cegis(plan, backend, listener, deadline).run()
+    variant = _variant_plan(plan) if verifier_only(plan) and not outcome.certified else None
+    if variant is not None:  # a given function may meet the variant's conditions instead
+        other = Cegis(variant, backend, listener, deadline).run()
+        if other.certified:
+            return variant, replace(other, strategy="given function")
     return plan, replace(outcome, strategy="learning" + (f" ({note})" if note else ""))
+
+
+def _variant_plan(plan: Plan) -> Plan | None:
+    """The plan with the conditions of the kernel rule's variant, if it has one."""
+    conditions = plan.certificate.variant_conditions()
+    return None if conditions is None else with_conditions(plan, conditions)
 
 
 def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
@@ -101,7 +119,7 @@ def _shaped_proof(plan: Plan, finding, backend: Backend, listener, deadline: flo
     lemma = _ball_left_out(plan, finding, radius)
     for attempt in (lemma,) if lemma.origin_radius == radius else \
             (lemma, replace(plan, origin_radius=radius)):
-        given, outcome = _given(attempt, backend, listener, deadline, finding,
+        given, outcome = _given(attempt, backend, listener, deadline, finding.formula,
                                 BASIN_QUERY_SECONDS, time.monotonic() + BASIN_REFUTING_SECONDS)
         if outcome.certified or time.monotonic() > deadline:
             break
@@ -158,31 +176,60 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
     finding = sos_reach.search(plan, time.monotonic() + budget)
     if finding is None:
         return None, "no sum-of-squares reach certificate found"
-    given = replace(plan, functions=tuple(replace(f, candidate=finding.formulas[f.name])
-                                          for f in plan.functions))
-    options = replace(given.options, query_timeout=min(given.options.query_timeout,
-                                                       SOS_QUERY_SECONDS))
-    cegis = Cegis(replace(given, options=options), backend, listener, deadline)
-    if finding.controller and not _controller_set(cegis, finding):
-        return None, f"{finding.describe()}: the controller network cannot hold its gain"
-    outcome = _refuted(given, cegis, time.monotonic() + REACH_REFUTING_SECONDS)
-    if not outcome.certified:
-        outcome = _merged(_verified_once(cegis), outcome.refutations)
-    if not outcome.certified:
-        return None, f"{finding.describe()}: not proved: {outcome.reason}"
-    return (given, replace(outcome, strategy=finding.describe())), ""
+    prepare = (lambda cegis: _controller_set(cegis, finding)) if finding.controller else None
+    return _proved(plan, backend, listener, deadline, finding, REACH_REFUTING_SECONDS,
+                   formulas=finding.formulas, prepare=prepare)
 
 
-def _controller_set(cegis: Cegis, finding) -> bool:
+def _conserved(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with B given, certified outcome) or None, what happened): B from conserved
+    quantities, proved by the non-increasing rule in continuous time; the solvers'
+    counterexamples to B's signs on I and U are added to the samples and B chosen again
+    (up to CONSERVED_REFINEMENTS times)."""
+    listener.phase(0, "conserved quantities")
+    budget = time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
+    variant = _variant_plan(plan) or plan
+    extra, note = ([], []), "no conserved quantity separates I from U"
+    for _ in range(CONSERVED_REFINEMENTS + 1):
+        finding = first_integral.search(plan, budget, extra)
+        if finding is None or time.monotonic() > budget:
+            break
+        prepare = (lambda cegis: _controller_set(cegis, finding)) if finding.controller \
+            else None
+        try:
+            given, outcome = _given(variant, backend, listener, deadline, finding.formula,
+                                    SOS_QUERY_SECONDS, time.monotonic() + REACH_REFUTING_SECONDS,
+                                    prepare)
+        except NotSetUp as exc:
+            return None, f"{finding.describe()}: {exc}"
+        if outcome.certified:
+            return (given, replace(outcome, strategy=finding.describe())), ""
+        note = f"{finding.describe()}: not proved: {outcome.reason}"
+        points = {v.condition: v.counterexample for v in outcome.verdicts
+                  if v.counterexample is not None}
+        if not points.keys() & {"initial", "unsafe"}:
+            break
+        for index, role in enumerate(("initial", "unsafe")):
+            if role in points:
+                extra[index].append(np.asarray(points[role], dtype=float).reshape(1, -1))
+    return None, note
+
+
+def _controller_set(cegis: Cegis, finding) -> None:
     """Sets the loop's controller network to the gain the functions were found for;
-    whether its exact formulas are the ones the program used."""
+    raises NotSetUp unless its exact formulas are the ones the program used."""
     from fossil_dsl.engine.linear import set_linear
     controller = cegis.learner.controller
     set_linear(controller, finding.gain, finding.operating)
     exact = controller.formulas(cegis.states, cegis.learner.digits)
     states = cegis.states
-    return all(sos_reach.same_polynomial(formula, finding.controller[u], states)
-               for u, formula in zip(cegis.plan.controller.inputs, exact))
+    if not all(sos_reach.same_polynomial(formula, finding.controller[u], states)
+               for u, formula in zip(cegis.plan.controller.inputs, exact)):
+        raise NotSetUp("the controller network cannot hold its gain")
+
+
+class NotSetUp(Exception):
+    """A found function's companion (a controller) could not be given to the loop."""
 
 
 def _verified_once(cegis: Cegis) -> CegisOutcome:
@@ -197,31 +244,41 @@ def _verified_once(cegis: Cegis) -> CegisOutcome:
                         (record,), 0.0, seconds, cegis.networks)
 
 
-def _proved(plan: Plan, backend: Backend, listener, deadline: float, finding, budget: float,
-            query_seconds: float = SOS_QUERY_SECONDS):
+def _proved(plan: Plan, backend: Backend, listener, deadline: float, finding,
+            refuting_seconds: float, query_seconds: float = SOS_QUERY_SECONDS,
+            formulas: dict | None = None, prepare=None):
     """((plan with the function given, certified outcome) or None, what happened)."""
-    given, outcome = _given(plan, backend, listener, deadline, finding, query_seconds,
-                            time.monotonic() + budget)
+    try:
+        given, outcome = _given(plan, backend, listener, deadline, formulas or finding.formula,
+                                query_seconds, time.monotonic() + refuting_seconds, prepare)
+    except NotSetUp as exc:
+        return None, f"{finding.describe()}: {exc}"
     if not outcome.certified:
         return None, f"{finding.describe()}: not proved: {outcome.reason}"
     return (given, replace(outcome, strategy=finding.describe())), ""
 
 
-def _given(plan: Plan, backend: Backend, listener, deadline: float, finding,
-           query_seconds: float, refuting_until: float | None = None):
-    """The plan with the found function as its candidate, and its outcome: proved by
-    refutations of the kernel's obligations where they settle every condition, else by
-    the solvers."""
-    given = replace(plan, functions=tuple(replace(f, candidate=finding.formula)
+def _given(plan: Plan, backend: Backend, listener, deadline: float, formulas,
+           query_seconds: float, refuting_until: float | None = None, prepare=None):
+    """The plan with the found functions as its candidates (a name -> formula map, or
+    one formula for its one function), and its outcome: proved by refutations of the
+    kernel's obligations where they settle every condition, else by the solvers; the
+    candidate is verified once (nothing is learned). `prepare(cegis)` sets up the rest
+    of the loop (a controller), raising NotSetUp where it cannot."""
+    if not isinstance(formulas, dict):
+        formulas = {f.name: formulas for f in plan.functions}
+    given = replace(plan, functions=tuple(replace(f, candidate=formulas[f.name])
                                           for f in plan.functions))
     options = replace(plan.options, query_timeout=min(plan.options.query_timeout,
                                                       query_seconds))
     cegis = Cegis(replace(given, options=options), backend, listener, deadline)
+    if prepare is not None:
+        prepare(cegis)
     listener.phase(0, "sum-of-squares refutations")
     outcome = _refuted(given, cegis, refuting_until or deadline)
     listener.finished(outcome.history[-1])
     if not outcome.certified:
-        outcome = _merged(cegis.run(), outcome.refutations)
+        outcome = _merged(_verified_once(cegis), outcome.refutations)
     return given, outcome
 
 

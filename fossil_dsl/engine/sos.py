@@ -118,16 +118,24 @@ def field_of(plan: Plan) -> list[P.Polynomial] | None:
         return None
 
 
-def set_constraints(region, states) -> list[P.Polynomial]:
-    """g with g >= 0 on the set, from its membership formula where that is a conjunction
-    of polynomial comparisons; others are left out (a program then asks for its
-    condition on a larger set, which is stronger)."""
+class Inexact(ValueError):
+    """A set whose membership is not a conjunction of polynomial comparisons (a union, a
+    complement), where a program needs the set itself."""
+
+
+def set_constraints(region, states, exact: bool = False) -> list[P.Polynomial]:
+    """g with g >= 0 on the set (closures of strict comparisons), from its membership
+    formula where that is a conjunction of polynomial comparisons. Other conjuncts raise
+    Inexact where `exact`, else are left out (a program then asks for its condition on a
+    larger set, which is stronger; but not where the set is one to stay out of, or one
+    to reach)."""
     found = []
     for atom in conjuncts(region.contains_formula(states)):
         try:
             found += [h for h, _ in comparisons(atom, states)]
-        except ValueError:
-            continue
+        except ValueError as exc:  # not a comparison, or not polynomial
+            if exact:
+                raise Inexact(str(exc)) from exc
     return found
 
 

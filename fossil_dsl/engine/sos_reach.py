@@ -26,7 +26,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from fossil_dsl.engine.sos import interval_products
+from fossil_dsl.engine.sos import Inexact, interval_products, set_constraints
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
@@ -34,8 +34,7 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.ir.sets import Complement, Intersection
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.rwa import GAMMA
-from fossil_dsl.plan.compile import Plan
-from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
+from fossil_dsl.plan.compile import Plan, default_synthesis
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
 
@@ -72,13 +71,8 @@ def applies(plan: Plan) -> bool:
     """A polynomial ODE, a reach-type property, the default templates, and at most a
     linear controller (the default one)."""
     spec = plan.spec
-    linear_controller = plan.controller is None or (
-        all(layer.activation == "linear" for layer in plan.controller.layers)
-        and spec.synthesis.controller is None)
     return (plan.certificate.form in FORMS and spec.time is TimeDomain.CONTINUOUS
-            and linear_controller and spec.torch_dynamics is None
-            and spec.synthesis.certificate is None and spec.synthesis.certificate2 is None
-            and spec.synthesis.candidate is None and not plan.options.learn_only
+            and default_synthesis(plan)
             and _polynomial(spec.dynamics, spec.states + spec.inputs) is not None)
 
 
@@ -142,20 +136,10 @@ def _polynomial(expressions, variables):
         return None
 
 
-class Inexact(ValueError):
-    """A set whose membership is not a conjunction of polynomial comparisons (a union, a
-    complement): the programs would ask for their conditions on the wrong set."""
-
-
-def constraints_of(region, states) -> list[P.Polynomial]:
-    """g_1, ..., g_k with the region = {every g_i >= 0} (closures of strict ones)."""
-    found = []
-    for atom in conjuncts(region.contains_formula(states)):
-        try:
-            found += [h for h, _ in comparisons(atom, states)]
-        except ValueError as exc:  # not a comparison, or not polynomial
-            raise Inexact(str(exc)) from exc
-    return found
+def _constraints(region, states) -> list[P.Polynomial]:
+    """The region's constraints, exactly: a program's condition on a larger set than
+    "outside S" or "G" would ask for the wrong thing."""
+    return set_constraints(region, states, exact=True)
 
 
 class _Pieces:
@@ -165,19 +149,19 @@ class _Pieces:
     def __init__(self, plan: Plan):
         spec, states = plan.spec, plan.states
         prop = spec.property
-        self.domain = constraints_of(spec.domain, states)
-        self.initial = interval_products(constraints_of(prop.role("initial"), states))
+        self.domain = _constraints(spec.domain, states)
+        self.initial = interval_products(_constraints(prop.role("initial"), states))
         unsafe = prop.role("unsafe")
         if prop.form == "reach":  # S is D
             outside_safe = []
         elif unsafe is not None and not isinstance(unsafe, Complement):  # S = D \ U
             outside_safe = [interval_products(
-                constraints_of(Intersection(unsafe, spec.domain), states))]
+                _constraints(Intersection(unsafe, spec.domain), states))]
         else:  # S is a set of its own (`S until G`)
             outside_safe = self.outside(prop.role("safe"), states)
         self.boundary = self.faces() + outside_safe
         self.outside_goal = self.outside(prop.role("goal"), states)
-        self.goal = interval_products(constraints_of(prop.role("goal"), states))
+        self.goal = interval_products(_constraints(prop.role("goal"), states))
         final = prop.role("final")
         self.outside_final = self.outside(final, states) if final is not None else None
 
@@ -189,7 +173,7 @@ class _Pieces:
     def outside(self, region, states) -> list[list[P.Polynomial]]:
         """D outside the region's interior: {g <= 0} within D, one piece per g."""
         return [[P.scale(g, -1)] + interval_products(self.domain)
-                for g in constraints_of(region, states)]
+                for g in _constraints(region, states)]
 
 
 def _functions(n: int, field, pieces: _Pieces, deadline: float):

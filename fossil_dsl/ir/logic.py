@@ -122,7 +122,9 @@ def _approximate(formula: Formula, same: dict, dual: dict) -> Formula:
 
 
 def truth(formula: Formula) -> bool | None:
-    """The exact truth value of a formula whose comparisons are between numbers."""
+    """The exact truth value of a formula where its comparisons between numbers decide
+    it (a conjunction with a false one is false, whatever the others; a numerical
+    procedure would read `0 > 0` as true within its tolerance), else None."""
     if isinstance(formula, BoolConst):
         return formula.value
     if isinstance(formula, Compare):
@@ -131,11 +133,12 @@ def truth(formula: Formula) -> bool | None:
         a, b = formula.left.value, formula.right.value
         return {"<=": a <= b, "<": a < b, ">=": a >= b, ">": a > b}[formula.relation]
     values = [truth(a) for a in children(formula)]
-    if None in values:
-        return None
     if isinstance(formula, Not):
-        return not values[0]
-    return all(values) if isinstance(formula, And) else any(values)
+        return None if values[0] is None else not values[0]
+    deciding = isinstance(formula, Or)  # the value that decides: True for Or, False for And
+    if deciding in values:
+        return deciding
+    return None if None in values else not deciding
 
 
 def children(formula: Formula) -> tuple[Formula, ...]:

@@ -6,7 +6,8 @@ difference equations, `definedness.py`),
 discharges each with a sound procedure (`prove.py`) and returns the verdict
 (`verdict.py`). It imports the IR and the solvers only: no torch, no learner.
 """
-from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation, guarantee_text
+from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation
+from fossil_dsl.kernel.registry import guarantee_text
 from fossil_dsl.kernel.prove import Outcome, Proof
 from fossil_dsl.kernel.verdict import Verdict, judge, list_obligations, not_certified
 

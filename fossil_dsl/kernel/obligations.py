@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import Callable, Mapping
+from typing import Mapping
 
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
@@ -184,109 +184,6 @@ def _expressions(formula: L.Formula):
     for comparison in L.comparisons(formula):
         yield comparison.left
         yield comparison.right
-
-
-RULES: dict[tuple[str, TimeDomain], Callable[[Facts], None]] = {}
-# What the rule's obligations prove, in words: a text, or a function of "discrete".
-GUARANTEES: dict[tuple[str, TimeDomain], str | Callable[[bool], str]] = {}
-
-
-@dataclass(frozen=True)
-class Strengthening:
-    """Further obligations that, proved on top of a rule's, give a stronger guarantee
-    (e.g. safety without "while they remain in D"). Not proving them never costs the
-    verdict, only the stronger words."""
-
-    name: str
-    add: Callable[[Facts], bool | None]  # False: does not apply to this claim
-    guarantee: str | Callable[[bool], str]
-
-
-STRENGTHENINGS: dict[tuple[str, TimeDomain], list[Strengthening]] = {}
-
-
-def strengthening(form: str, *times: TimeDomain, name: str,
-                  guarantee: str | Callable[[bool], str]):
-    def register(function):
-        for time in times:
-            STRENGTHENINGS.setdefault((form, time), []).append(
-                Strengthening(name, function, guarantee))
-        return function
-    return register
-
-
-def rule(form: str, *times: TimeDomain, guarantee: str | Callable[[bool], str]):
-    """Register a rule, and the guarantee that its obligations, once proved, give."""
-    def register(function):
-        for time in times or (TimeDomain.CONTINUOUS,):
-            RULES[(form, time)] = function
-            GUARANTEES[(form, time)] = guarantee
-        return function
-    return register
-
-
-def guarantee_text(spec: CheckedSpec, ball_radius: Fraction, controlled: bool,
-                   strengthened: Strengthening | None = None) -> str:
-    """What a certified claim guarantees, in words: the rule's guarantee (or a proved
-    strengthening's), weakened where a ball round the origin was left out, and said of
-    the closed loop where there is a controller."""
-    key = (spec.property.form, spec.time)
-    if key not in GUARANTEES:
-        raise NoRule(f"no sound rule for {key[0]} in {key[1].value} time")
-    text = GUARANTEES[key] if strengthened is None else strengthened.guarantee
-    text = text if isinstance(text, str) else text(spec.time is TimeDomain.DISCRETE)
-    if ball_radius > 0:
-        r = E.Num(ball_radius)
-        text = (f"ε-stability for ε = {r}: the conditions that exclude the origin were "
-                f"proved outside the ball |x| <= {r} only, so trajectories reach, and stay "
-                "in, the smallest sublevel set of V that contains that ball, rather than "
-                f"converging to the origin itself. Apart from that ball: {text}")
-    return text + (" (for the closed loop with the controller shown)" if controlled else "")
-
-
-def derive(claim: Claim, strengthened: str | None = None) -> list[Obligation]:
-    """The complete list of obligations for the claim's property (with those of the
-    named strengthening); NoRule if none is sound."""
-    obligations = derive_facts(claim)[0]
-    for option, extra, _ in derive_strengthenings(claim):
-        if option.name == strengthened:
-            obligations += extra
-    return obligations
-
-
-def derive_facts(claim: Claim) -> tuple[list[Obligation], str]:
-    """The obligations, and the guarantee they give once proved."""
-    facts = Facts(claim)
-    key = (claim.spec.property.form, claim.spec.time)
-    if key not in RULES:
-        raise NoRule(f"no sound rule for {key[0]} in {key[1].value} time")
-    common(facts)
-    RULES[key](facts)
-    excluded = facts.ball_left_out and not facts.ball_covered
-    guarantee = guarantee_text(claim.spec, claim.ball_radius if excluded else 0,
-                               bool(claim.controller))
-    return _unique(facts.obligations), guarantee
-
-
-def derive_strengthenings(claim: Claim) -> list[tuple[Strengthening, list[Obligation], str]]:
-    """For each strengthening of the claim's rule, strongest first: its further
-    obligations and the guarantee the rule's and these give together."""
-    found = []
-    for option in STRENGTHENINGS.get((claim.spec.property.form, claim.spec.time), []):
-        facts = Facts(claim)
-        if option.add(facts) is False:
-            continue
-        guarantee = guarantee_text(claim.spec, claim.ball_radius if facts.ball_left_out
-                                   else 0, bool(claim.controller), option)
-        found.append((option, _unique(facts.obligations), guarantee))
-    return found
-
-
-def _unique(obligations: list[Obligation]) -> list[Obligation]:
-    found: dict[str, Obligation] = {}
-    for obligation in obligations:
-        found.setdefault(obligation.name, obligation)
-    return list(found.values())
 
 
 def common(facts: Facts) -> None:

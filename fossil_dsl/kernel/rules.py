@@ -13,8 +13,8 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.kernel.local import negative_near_origin
-from fossil_dsl.kernel.obligations import (BALL_ROOM, GAMMA, Claim, Facts, Obligation, rule,
-                                           strengthening)
+from fossil_dsl.kernel.obligations import BALL_ROOM, GAMMA, Claim, Facts, Obligation
+from fossil_dsl.kernel.registry import rule, strengthening
 
 CONTINUOUS, DISCRETE = TimeDomain.CONTINUOUS, TimeDomain.DISCRETE
 ZERO = E.ZERO
@@ -122,13 +122,6 @@ def reach_guarantee(safe_words: str, goal_words: str) -> str:
             f"outside {goal_words} ({safe_words} is bounded, so V cannot decrease forever)")
 
 
-def safety_guarantee(discrete: bool) -> str:
-    return ("trajectories from I never enter U while they remain in D: B <= 0 on I, "
-            "B > 0 on U, and the zero level set of B cannot be crossed outwards "
-            + ("(the set {B <= 0} is mapped into itself)" if discrete
-               else "(B strictly decreases wherever B = 0)"))
-
-
 @rule("stability", CONTINUOUS, DISCRETE, guarantee=stability_guarantee)
 def stability(facts: Facts) -> None:
     equilibrium(facts, "V")
@@ -198,14 +191,21 @@ strengthening("region of attraction", CONTINUOUS, name="no ball left out",
               guarantee=ROA_GUARANTEE)(no_ball_left_out)
 
 
-def barrier_conditions(facts: Facts, name: str, inside: L.Formula, outside: L.Formula,
-                       inside_words: str, outside_words: str, prefix: str = "") -> None:
-    B, dB = facts.value(name), facts.change(name)
-    domain = facts.member(facts.spec.domain)
+def barrier_signs(facts: Facts, name: str, inside: L.Formula, outside: L.Formula,
+                  inside_words: str, outside_words: str, prefix: str = "") -> None:
+    """name <= 0 on `inside`, > 0 on `outside` within D."""
+    B = facts.value(name)
     facts.holds(f"condition:{prefix}initial", f"{name}(x) <= 0 on {inside_words}", inside,
                 compare("<=", B))
     facts.holds(f"condition:{prefix}unsafe", f"{name}(x) > 0 on {outside_words} within D",
-                L.conjunction(outside, domain), compare(">", B))
+                L.conjunction(outside, facts.member(facts.spec.domain)), compare(">", B))
+
+
+def barrier_conditions(facts: Facts, name: str, inside: L.Formula, outside: L.Formula,
+                       inside_words: str, outside_words: str, prefix: str = "") -> None:
+    barrier_signs(facts, name, inside, outside, inside_words, outside_words, prefix)
+    B, dB = facts.value(name), facts.change(name)
+    domain = facts.member(facts.spec.domain)
     if facts.discrete:
         facts.holds(f"condition:{prefix}invariance", f"{name}(f(x)) <= 0 for x in D with "
                     f"{name}(x) <= 0", L.conjunction(domain, compare("<=", B)),
@@ -214,38 +214,6 @@ def barrier_conditions(facts: Facts, name: str, inside: L.Formula, outside: L.Fo
         level = L.conjunction(domain, compare("<=", B), compare(">=", B))
         facts.holds(f"condition:{prefix}flow", f"d{name}/dt < 0 for x in D with "
                     f"{name}(x) = 0", level, compare("<", dB))
-
-
-@rule("safety", CONTINUOUS, DISCRETE, guarantee=safety_guarantee)
-def safety(facts: Facts) -> None:
-    initial, unsafe = facts.member(facts.role("initial")), facts.member(facts.role("unsafe"))
-    facts.inside("relation:initial in domain", "I lies in D", initial,
-                 facts.member(facts.spec.domain))
-    facts.disjoint("relation:initial and unsafe", "I and U are disjoint", initial, unsafe)
-    barrier_conditions(facts, "B", initial, unsafe, "I", "U")
-
-
-UNCONDITIONAL_SAFETY = (
-    "trajectories from I never enter U, and never leave D: B <= 0 on I, B > 0 on U within "
-    "D, the zero level set of B cannot be crossed outwards in D {how}, and {exit}")
-
-
-@strengthening("safety", CONTINUOUS, name="never leaves D", guarantee= UNCONDITIONAL_SAFETY.format(
-    how="(B strictly decreases wherever B = 0)",
-    exit="B > 0 on the boundary of D, so a trajectory would have to cross B = 0 in D "
-         "before it could leave D"))
-def safety_on_the_boundary(facts: Facts) -> None:
-    facts.holds("strong:boundary", "B(x) > 0 on the boundary of D",
-                facts.boundary(facts.spec.domain), compare(">", facts.value("B")))
-
-
-@strengthening("safety", DISCRETE, name="never leaves D", guarantee= UNCONDITIONAL_SAFETY.format(
-    how="(the set {B <= 0} is mapped into itself)",
-    exit="every x in D with B(x) <= 0 is mapped into D, so no step leaves D"))
-def safety_steps_stay_in_domain(facts: Facts) -> None:
-    domain = facts.spec.domain
-    facts.lands_in("strong:image", "f(x) lies in D for every x in D with B(x) <= 0",
-                   L.conjunction(facts.member(domain), compare("<=", facts.value("B"))), domain)
 
 
 SWA_GUARANTEE = ROA_GUARANTEE + ("; and those trajectories never enter U: B <= 0 on I, "

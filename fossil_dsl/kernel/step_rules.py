@@ -13,7 +13,8 @@ from __future__ import annotations
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
-from fossil_dsl.kernel.obligations import GAMMA, Facts, rule
+from fossil_dsl.kernel.obligations import GAMMA, Facts
+from fossil_dsl.kernel.registry import rule
 from fossil_dsl.kernel.rules import (DISCRETE, barrier_conditions, compare,
                                      region_of_attraction, stable_while_avoid)
 

@@ -9,9 +9,10 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-from fossil_dsl.kernel import rules, step_rules  # noqa: F401  (registers the rules)
-from fossil_dsl.kernel.obligations import (Claim, NoRule, Obligation, derive, derive_facts,
-                                           derive_strengthenings)
+from fossil_dsl.kernel import rules, safety_rules, step_rules  # noqa: F401  (registers them)
+from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation
+from fossil_dsl.kernel.registry import (derive, derive_facts, derive_strengthenings,
+                                        rule_variants)
 from fossil_dsl.kernel.prove import Outcome, Proof, discharge
 
 _SEAL = object()
@@ -28,6 +29,7 @@ class Verdict:
     guarantee: str = "nothing is proved"  # in words, from the rule; only when certified
     strengthened: str | None = None  # the strengthening whose obligations were proved too
     _seal: object = field(default=None, repr=False, compare=False)
+    variant: str | None = None  # the variant of the rule that was proved (None: the main)
 
     def __post_init__(self):
         if self.certified and self._seal is not _SEAL:
@@ -42,47 +44,64 @@ def not_certified(reason: str) -> Verdict:
     return Verdict(False, reason)
 
 
-def list_obligations(claim: Claim, strengthened: str | None = None) -> list[Obligation]:
-    """Every obligation of the claim, with the named strengthening's (raises NoRule where
-    the kernel has no rule)."""
-    return derive(claim, strengthened)
+def list_obligations(claim: Claim, strengthened: str | None = None,
+                     variant: str | None = None) -> list[Obligation]:
+    """Every obligation of the claim by the main rule or the named variant, with the
+    named strengthening's (raises NoRule where the kernel has no rule)."""
+    return derive(claim, strengthened, variant)
 
 
 def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
           delta: float | None = None, pieces=None) -> Verdict:
-    """Prove every obligation; stop at the first that is not proved. `pieces` checks
-    the pieces of split interval queries in parallel (their cover is checked here)."""
+    """Prove every obligation of the main rule, stopping at the first that is not
+    proved; where one is not, the same for each variant of the rule (an obligation they
+    share is proved once). `pieces` checks the pieces of split interval queries in
+    parallel (their cover is checked here)."""
     started = time.monotonic()
     try:
-        found, guarantee = derive_facts(claim)
+        variants = rule_variants(claim.spec)
+        derive_facts(claim)
     except NoRule as exc:
         return not_certified(f"the kernel cannot judge this claim: {exc}")
-    proofs, proved = _prove_all(found, claim, timeout, delta, pieces)
+    known: dict[Obligation, Proof] = {}
+    first_failure = None
+    for variant in variants:
+        found, guarantee = derive_facts(claim, variant)
+        proofs, proved = _prove_all(found, claim, timeout, delta, pieces, known)
+        if proved:
+            break
+        first_failure = first_failure or proofs  # the main rule's failure is reported
     if not proved:
-        return Verdict(False, _failure_text(proofs[-1]), tuple(proofs),
+        return Verdict(False, _failure_text(first_failure[-1]), tuple(first_failure),
                        time.monotonic() - started)
     strengthened = None
-    for option, extra, stronger in derive_strengthenings(claim):
-        more, proved = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta,
-                                  pieces)
-        if proved:
+    for option, extra, stronger in derive_strengthenings(claim, variant):
+        more, done = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta,
+                                pieces)
+        if done:
             proofs += more
             guarantee, strengthened = stronger, option.name
             break
     return Verdict(True, f"all {len(proofs)} obligations proved", tuple(proofs),
-                   time.monotonic() - started, guarantee, strengthened, _SEAL)
+                   time.monotonic() - started, guarantee, strengthened, _SEAL, variant)
 
 
 def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
-               delta: float | None, pieces=None) -> tuple[list[Proof], bool]:
+               delta: float | None, pieces=None,
+               known: dict | None = None) -> tuple[list[Proof], bool]:
     """The proofs up to the first obligation not proved, and whether all were proved.
-    The procedure that proved a condition in the run goes first (only the order)."""
+    The procedure that proved a condition in the run goes first (only the order);
+    `known` holds the proofs of obligations decided before, and gains these."""
     proofs = []
+    known = {} if known is None else known
     for obligation in obligations:
-        first = claim.procedures.get(obligation.name.removeprefix("condition:"),
-                                     obligation.first)
-        proofs.append(discharge(obligation, claim.spec.states, timeout, delta, first,
-                                claim.refutations.get(obligation.name), pieces))
+        if obligation not in known:
+            first = claim.procedures.get(obligation.name.removeprefix("condition:"),
+                                         obligation.first)
+            known[obligation] = discharge(obligation, claim.spec.states, timeout, delta,
+                                          first, claim.refutations.get(obligation.name),
+                                          pieces)
+        proofs.append(known[obligation])
         if not proofs[-1].proved:
             return proofs, False
     return proofs, True

@@ -144,7 +144,8 @@ def _derive(data: dict):
                   {k: Fraction(v) for k, v in data.get("levels", {}).items()},
                   Fraction(data.get("excluded_ball", "0")))
     try:
-        return spec, list_obligations(claim, data.get("kernel", {}).get("strengthening"))
+        kernel = data.get("kernel", {})
+        return spec, list_obligations(claim, kernel.get("strengthening"), kernel.get("variant"))
     except NoRule as exc:
         raise RecheckError(f"the kernel has no rule for this result: {exc}") from exc
 

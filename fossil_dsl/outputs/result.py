@@ -165,6 +165,7 @@ def kernel_json(verdict: Verdict) -> dict:
     return {"verdict": "certified" if verdict.certified else "not certified",
             "reason": verdict.reason, "seconds": _seconds(verdict.seconds),
             "strengthening": verdict.strengthened,
+            "variant": verdict.variant,
             "obligations": [{"name": p.obligation.name, "text": p.obligation.text,
                              "outcome": p.outcome.value, "procedure": p.procedure,
                              "detail": p.detail, "witness": None if p.witness is None
@@ -244,7 +245,8 @@ def build_result(plan: Plan, outcome: CegisOutcome, verdict: Verdict,
             f"{verdict.reason}"
     return Result(plan, verdict.certified, reason, dict(candidate.formulas),
                   dict(candidate.controller), dict(candidate.levels), reports,
-                  obligations(plan, outcome, verdict.strengthened), len(outcome.history), outcome.learn_seconds,
+                  obligations(plan, outcome, verdict.strengthened, verdict.variant),
+                  len(outcome.history), outcome.learn_seconds,
                   outcome.verify_seconds, total_seconds, candidate.digits,
                   dict(outcome.networks), verdict, outcome.interrupted, outcome.strategy,
                   {**outcome.refutations, **_found_by_kernel(verdict)})
@@ -256,13 +258,13 @@ def _found_by_kernel(verdict: Verdict) -> dict:
     return {p.obligation.name: p.evidence for p in verdict.proofs if p.evidence is not None}
 
 
-def obligations(plan: Plan, outcome: CegisOutcome,
-                strengthened: str | None = None) -> dict[str, str]:
+def obligations(plan: Plan, outcome: CegisOutcome, strengthened: str | None = None,
+                variant: str | None = None) -> dict[str, str]:
     """The kernel's obligations for the final formulas (with those of the strengthening
     it proved) as SMT-LIB 2 scripts (unsat means proved); the engine's condition queries
     where the kernel has no rule."""
     try:
-        found = kernel_obligations(claim_of(plan, outcome), strengthened)
+        found = kernel_obligations(claim_of(plan, outcome), strengthened, variant)
     except NoRule:
         return condition_scripts(plan, outcome)
     return {o.file_stem: script(o, plan.states, plan.spec.name) for o in found}

@@ -120,6 +120,27 @@ def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None
                 verifier, reason, MappingProxyType(samples), options, radius, fallback)
 
 
+def default_synthesis(plan: Plan) -> bool:
+    """No template, candidate or controller chosen by the user (at most the default
+    linear controller), no torch dynamics, and not learn-only: where the engine may put
+    functions of its own choosing (a program's, a conserved quantity) in the templates'
+    place."""
+    spec = plan.spec
+    linear_controller = plan.controller is None or (
+        spec.synthesis.controller is None
+        and all(layer.activation == "linear" for layer in plan.controller.layers))
+    return (linear_controller and spec.torch_dynamics is None
+            and spec.synthesis.certificate is None and spec.synthesis.certificate2 is None
+            and spec.synthesis.candidate is None and not plan.options.learn_only)
+
+
+def with_conditions(plan: Plan, conditions) -> Plan:
+    """The plan with other conditions (those of a variant of the kernel's rule), and
+    their sample counts."""
+    samples = {c.name: _sample_count(plan.spec, c.region) for c in conditions}
+    return replace(plan, conditions=tuple(conditions), samples=MappingProxyType(samples))
+
+
 def origin_radius(spec: CheckedSpec) -> Fraction:
     """The ball a delta-decision verifier leaves out round the origin: ORIGIN_RADIUS, or
     a power of ten small enough that ten times it fits in the domain's box (the kernel

@@ -57,3 +57,12 @@ class Barrier(Certificate):
         return barrier_conditions(self, "B", self.role("initial"), self.role("unsafe"),
                                   "I", "U")
 
+    def variant_conditions(self) -> tuple[Condition, ...] | None:
+        """The conditions of the kernel's variant rule for continuous time (B never
+        increases in D; kernel/safety_rules.py): what a conserved quantity meets."""
+        if self.discrete:
+            return None
+        initial, unsafe, _ = self.conditions()
+        flow = Condition("non-increasing", "dB/dt <= 0 for every x in D", self.spec.domain,
+                         L.Compare("<=", change_of("B"), E.ZERO))
+        return initial, unsafe, flow

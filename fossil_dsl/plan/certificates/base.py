@@ -154,6 +154,11 @@ class Certificate:
     def levels(self) -> tuple[Level, ...]:
         return ()
 
+    def variant_conditions(self) -> tuple[Condition, ...] | None:
+        """The conditions of a variant of the kernel's rule (kernel/registry.py), to
+        try where the main ones cannot be met; None where there is none."""
+        return None
+
     @property
     def discrete(self) -> bool:
         return self.spec.time is TimeDomain.DISCRETE

@@ -1,0 +1,157 @@
+"""Conserved quantities (engine/first_integral.py) and the kernel's variant rule for
+continuous-time safety, "B never increases in D" (kernel/safety_rules.py): an undamped
+oscillator's safety, which no B that strictly decreases on its zero level set can show
+(the flow preserves area), is certified; a B that does increase is not, by either rule."""
+import json
+from fractions import Fraction
+
+import fossil_dsl
+from fossil_dsl.engine import first_integral
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.kernel import Claim, judge
+from fossil_dsl.outputs.recheck import recheck
+from fossil_dsl.plan.compile import compile_spec
+
+OSCILLATOR = """\
+state x, y
+dynamics continuous {
+    x' = y
+    y' = -x
+}
+domain box([-3, -3], [3, 3])
+set init   = ball([0, 0], 0.5)
+set unsafe = ~ball([0, 0], 2)
+prove from init: always not unsafe
+"""
+
+# x'' = -x - x^3 (undamped Duffing): conserved 2y^2 + 2x^2 + x^4, a quartic
+DUFFING = OSCILLATOR.replace("y' = -x", "y' = -x - x^3")
+
+# an outward spiral: trajectories from I do leave the ball of radius 2
+SPIRAL = OSCILLATOR.replace("x' = y", "x' = y + x / 10").replace("y' = -x", "y' = -x + y / 10")
+
+UNICYCLE = """\
+state x1, x2, x3
+input u0, u1
+dynamics continuous {
+    x1' = u0*cos(x3)
+    x2' = u0*sin(x3)
+    x3' = u1
+}
+domain box([-10, -10, -6.28], [10, 10, 6.28])
+set init   = box([-1, -1, -0.5], [1, 1, 0.5])
+set unsafe = ~box([-5, -5, -3.14], [5, 5, 3.14])
+prove from init: always not unsafe
+"""
+
+ROTATION = """\
+state x, y
+dynamics discrete {
+    next(x) = 3/5*x - 4/5*y
+    next(y) = 4/5*x + 3/5*y
+}
+domain box([-3, -3], [3, 3])
+set init   = ball([0, 0], 0.5)
+set unsafe = ~ball([0, 0], 2)
+prove from init: always not unsafe
+"""
+
+
+def claim(text: str, b: E.Expr) -> Claim:
+    return Claim(fossil_dsl.loads(text), {"B": b})
+
+
+def circle(radius_squared) -> E.Expr:
+    x, y = E.Var("x"), E.Var("y")
+    return E.add(E.power(x, E.Num(2)), E.power(y, E.Num(2)), E.Num(-Fraction(radius_squared)))
+
+
+def test_a_conjunction_with_a_false_comparison_of_numbers_is_false():
+    x = E.Var("x")
+    never = L.Compare(">", E.ZERO, E.ZERO)
+    somewhere = L.Compare("<", x, E.Num(1))
+    assert L.truth(L.conjunction(somewhere, never)) is False
+    assert L.truth(L.disjunction(somewhere, never)) is None
+    assert L.truth(L.disjunction(somewhere, L.negation(never))) is True
+
+
+def test_the_kernel_proves_a_conserved_barrier_by_the_variant_rule():
+    verdict = judge(claim(OSCILLATOR, circle(1)))
+    assert verdict.certified, verdict.reason
+    assert verdict.variant == "non-increasing B"
+    names = [p.obligation.name for p in verdict.proofs]
+    assert "condition:non-increasing" in names and "condition:flow" not in names
+    assert "dB/dt <= 0 throughout D" in verdict.guarantee
+
+
+def test_a_barrier_that_increases_is_refused_by_both_rules():
+    verdict = judge(claim(SPIRAL, circle(1)))
+    assert not verdict.certified
+    assert "condition:flow" in verdict.reason  # the main rule's failure is reported
+
+
+def test_the_main_rule_is_used_where_it_holds():
+    damped = OSCILLATOR.replace("y' = -x", "y' = -x - y")
+    x, y = E.Var("x"), E.Var("y")
+    # V = x^2 + xy + y^2 decreases strictly away from 0 for x' = y, y' = -x - y
+    b = E.add(E.power(x, E.Num(2)), E.mul(x, y), E.power(y, E.Num(2)), E.Num(-1))
+    verdict = judge(claim(damped, b))
+    assert verdict.certified and verdict.variant is None, verdict.reason
+
+
+def test_the_conserved_polynomials_are_found_exactly():
+    field = [{(0, 1): Fraction(1)}, {(1, 0): Fraction(-1), (3, 0): Fraction(-1)}]
+    quadratic = first_integral.conserved(field, 2, 2, discrete=False)
+    assert quadratic == []  # x^2 + y^2 is not conserved with the cubic term
+    quartic = first_integral.conserved(field, 2, 4, discrete=False)
+    assert len(quartic) >= 1
+    for h in quartic:
+        assert P.lie_derivative(h, field) == {}
+    expected = {(2, 0): Fraction(1), (0, 2): Fraction(1), (4, 0): Fraction(1, 2)}
+    assert any(h in (expected, P.scale(expected, -1)) for h in quartic), quartic
+
+
+def test_undamped_oscillators_safety_is_certified_and_rechecked(tmp_path):
+    for text in (OSCILLATOR, DUFFING):
+        result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=60)
+        assert result.certified, result.summary()
+        assert result.strategy.startswith("a conserved quantity"), result.strategy
+        assert result.kernel.variant == "non-increasing B"
+        assert result.kernel.strengthened == "never leaves D"
+    folder = tmp_path / "duffing"
+    result.save(folder)
+    data = json.loads((folder / "result.json").read_text())
+    assert data["kernel"]["variant"] == "non-increasing B"
+    checks = recheck(folder, timeout=30)
+    assert checks and all(c.reproved for c in checks), checks
+
+
+def test_an_outward_spiral_is_not_certified():
+    plan = compile_spec(fossil_dsl.loads(SPIRAL))
+    assert first_integral.applies(plan)
+    assert first_integral.search(plan, float("inf")) is None  # nothing is conserved
+    result = fossil_dsl.synthesise(fossil_dsl.loads(SPIRAL), timeout=20, max_iters=5)
+    assert not result.certified
+
+
+def test_a_drift_free_system_is_safe_with_its_inputs_held():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(UNICYCLE), timeout=60)
+    assert result.certified, result.summary()
+    assert result.sympy["u0"] == 0 and result.sympy["u1"] == 0
+    assert result.kernel.variant == "non-increasing B"
+
+
+def test_a_rotation_map_keeps_its_circles_by_the_main_rule():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(ROTATION), timeout=60)
+    assert result.certified, result.summary()
+    assert result.strategy.startswith("a conserved quantity")
+    assert result.kernel.variant is None  # a map's rule is met by B(f(x)) = B(x)
+
+
+def test_a_given_conserved_barrier_is_certified():
+    text = OSCILLATOR + "synthesis {\n    candidate: x^2 + y^2 - 1\n}\n"
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=30)
+    assert result.certified, result.summary()
+    assert result.kernel.variant == "non-increasing B"
