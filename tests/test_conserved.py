@@ -7,9 +7,11 @@ from fractions import Fraction
 
 import fossil_dsl
 from fossil_dsl.engine import first_integral
+from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.atoms import folded
 from fossil_dsl.kernel import Claim, judge
 from fossil_dsl.outputs.recheck import recheck
 from fossil_dsl.plan.compile import compile_spec
@@ -101,16 +103,23 @@ def test_the_main_rule_is_used_where_it_holds():
     assert verdict.certified and verdict.variant is None, verdict.reason
 
 
-def test_the_conserved_polynomials_are_found_exactly():
-    field = [{(0, 1): Fraction(1)}, {(1, 0): Fraction(-1), (3, 0): Fraction(-1)}]
-    quadratic = first_integral.conserved(field, 2, 2, discrete=False)
-    assert quadratic == []  # x^2 + y^2 is not conserved with the cubic term
-    quartic = first_integral.conserved(field, 2, 4, discrete=False)
-    assert len(quartic) >= 1
-    for h in quartic:
-        assert P.lie_derivative(h, field) == {}
-    expected = {(2, 0): Fraction(1), (0, 2): Fraction(1), (4, 0): Fraction(1, 2)}
-    assert any(h in (expected, P.scale(expected, -1)) for h in quartic), quartic
+def test_the_conserved_functions_are_found_exactly():
+    x, y = E.Var("x"), E.Var("y")
+    duffing = [y, E.add(E.neg(x), E.neg(E.power(x, E.Num(3))))]
+    quadratic = first_integral._candidates(duffing, ["x", "y"], 2)
+    assert first_integral.conserved(quadratic, duffing, ["x", "y"], False) == []
+    quartic = first_integral._candidates(duffing, ["x", "y"], 4)
+    found = first_integral.conserved(quartic, duffing, ["x", "y"], False)
+    energy = {(2, 0): Fraction(1), (0, 2): Fraction(1), (4, 0): Fraction(1, 2)}
+    polynomials = [P.polynomial(h, ["x", "y"]) for h in found]
+    assert any(h in (energy, P.scale(energy, -1)) for h in polynomials), polynomials
+    # the pendulum's energy, with cos: its derivative is 0 over the atoms
+    pendulum = [y, E.neg(E.apply("sin", x))]
+    found = first_integral.conserved(first_integral._candidates(pendulum, ["x", "y"], 2),
+                                     pendulum, ["x", "y"], False)
+    assert len(found) == 1 and "cos(x)" in E.to_text(found[0]), found
+    change = calculus.lie_derivative(found[0], ["x", "y"], pendulum)
+    assert L.truth(folded(L.Compare(">", change, E.ZERO), ["x", "y"])) is False
 
 
 def test_undamped_oscillators_safety_is_certified_and_rechecked(tmp_path):
@@ -126,6 +135,17 @@ def test_undamped_oscillators_safety_is_certified_and_rechecked(tmp_path):
     assert data["kernel"]["variant"] == "non-increasing B"
     checks = recheck(folder, timeout=30)
     assert checks and all(c.reproved for c in checks), checks
+
+
+def test_an_undamped_pendulums_safety_is_certified_with_its_energy():
+    text = OSCILLATOR.replace("y' = -x", "y' = -sin(x)")
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=60)
+    assert result.certified, result.summary()
+    assert "cos(x)" in E.to_text(result.formulas["B"])
+    assert result.kernel.variant == "non-increasing B"
+    non_increasing = next(p for p in result.kernel.proofs
+                          if p.obligation.name == "condition:non-increasing")
+    assert non_increasing.procedure == "exact arithmetic"
 
 
 def test_an_outward_spiral_is_not_certified():

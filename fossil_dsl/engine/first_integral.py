@@ -1,9 +1,12 @@
-"""Conserved quantities as barriers, for safety of a polynomial system.
+"""Conserved quantities as barriers, for safety.
 
-The polynomials H of degree at most d (no constant term) with dH/dt = 0 along x' = f(x)
-(H(f(x)) = H(x) for a map) form a linear space: the conditions are linear equations in
-H's coefficients, with the rational coefficients of f, so the space is found exactly
-(python-flint's integer null space). B = sum_k a_k H_k + c is then chosen by a linear
+The combinations H of a few functions (the monomials of degree 1..d, and sin and cos of
+each argument of a sin or cos in the field) with dH/dt = 0 along x' = f(x) (H(f(x)) =
+H(x) for a map) form a linear space: written over the states and the field's atoms as
+indeterminates (ir/atoms.py), the conditions are linear equations in H's coefficients
+with rational entries, so the space is found exactly (python-flint's integer null
+space); a combination whose change is 0 over independent indeterminates is 0 for every
+value they take. An undamped pendulum's energy y^2 - 2 cos(x) is one. B = sum_k a_k H_k + c is then chosen by a linear
 program on samples (B <= -e on I, B >= e on U within D, largest e); a and c are rounded,
 and B stays exactly conserved whatever the rounding. In continuous time no B can
 strictly decrease on its zero level set where the flow conserves volume (an undamped
@@ -23,10 +26,13 @@ from fractions import Fraction
 
 import numpy as np
 
+from fossil_dsl.engine.evaluate import evaluate, state_env
 from fossil_dsl.engine.sampling import sample
+from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
+from fossil_dsl.ir.atoms import AtomTable
 from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan, default_synthesis
@@ -51,8 +57,9 @@ class ConservedFinding:
 
     def describe(self) -> str:
         held = " with the inputs held at the operating point" if self.controller else ""
-        return (f"a conserved quantity{held}: B in the span of {self.count} polynomial "
-                f"first integrals of degree <= {self.degree} (exact null space), margin "
+        return (f"a conserved quantity{held}: B in the span of {self.count} first "
+                f"integrals (monomials of degree <= {self.degree}, sin, cos; exact null "
+                f"space), margin "
                 f"{self.margin:.3g} on the samples, {self.seconds:.2f} s")
 
 
@@ -62,62 +69,78 @@ def applies(plan: Plan) -> bool:
 
 
 def search(plan: Plan, deadline: float, extra=None) -> ConservedFinding | None:
-    """B from the conserved polynomials of the lowest degree that separate the samples
-    of I and U (with `extra`: (points of I, points of U) found by the solvers), or None."""
+    """B from the conserved functions of the lowest degree that separate the samples of
+    I and U (with `extra`: (points of I, points of U) found by the solvers), or None."""
     started = time.monotonic()
     spec, states = plan.spec, plan.states
     operating = np.zeros(0)
     if spec.inputs:
         from fossil_dsl.engine.linear import operating_point  # imports torch
         operating = operating_point(spec)
-    if operating is None:
-        return None
+        if operating is None:
+            return None
     held = {u: E.Num(Fraction(str(round(float(v), plan.options.digits))))
             for u, v in zip(spec.inputs, operating)}
-    try:
-        field = [P.polynomial(traversal.substitute(f, held), states) for f in spec.dynamics]
-    except P.NotPolynomial:
-        return None
+    field = [traversal.substitute(f, held) for f in spec.dynamics]
     samples = None
     for degree in DEGREES:
-        if time.monotonic() > deadline or len(P.monomials(len(states), 1, degree)) > MAX_BASIS:
+        candidates = _candidates(field, states, degree)
+        if time.monotonic() > deadline or len(candidates) > MAX_BASIS:
             return None
-        basis = conserved(field, len(states), degree, spec.time is TimeDomain.DISCRETE)
+        basis = conserved(candidates, field, states, spec.time is TimeDomain.DISCRETE)
         if not basis:
             continue
         samples = samples or _samples(plan, extra)
-        found = _separating(basis, *samples)
+        found = _separating(basis, states, *samples)
         if found is not None:
             b, margin = found
-            return ConservedFinding(P.to_expr(b, states), held, operating,
-                                    np.zeros((len(held), len(states))), len(basis), degree,
-                                    margin, time.monotonic() - started)
+            return ConservedFinding(b, held, operating, np.zeros((len(held), len(states))),
+                                    len(basis), degree, margin, time.monotonic() - started)
     return None
 
 
-def conserved(field, n: int, degree: int, discrete: bool) -> list[P.Polynomial]:
-    """A basis of the polynomials H of degree 1..degree with H's change 0, each scaled
-    to largest coefficient 1 (exact)."""
+def _candidates(field, states, degree: int) -> list[E.Expr]:
+    """The monomials of degree 1..degree, then sin and cos of each argument of a sin or
+    cos in the field."""
+    monomials = [E.mul(*(E.power(E.Var(s), E.Num(k)) for s, k in zip(states, m) if k))
+                 for m in P.monomials(len(states), 1, degree)]
+    arguments = dict.fromkeys(node.arg for f in field for node in E.walk(f)
+                              if isinstance(node, E.Apply) and node.func in ("sin", "cos"))
+    return monomials + [E.apply(func, a) for a in arguments for func in ("sin", "cos")]
+
+
+def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:
+    """A basis (exact, each scaled to largest weight 1) of the combinations of the
+    candidates whose change along the system is identically 0 over the atoms."""
     import flint
-    basis = P.monomials(n, 1, degree)
-    changes = [P.change({m: Fraction(1)}, field, discrete) for m in basis]
-    rows = sorted({m for change in changes for m in change})
-    if not rows:  # every monomial is conserved (f = 0, or the identity map)
-        return [{m: Fraction(1)} for m in basis]
-    table = [[changes[j].get(m, Fraction(0)) for j in range(len(basis))] for m in rows]
-    integers = [_integer_row(row) for row in table]
-    space, count = flint.fmpz_mat(len(rows), len(basis), sum(integers, [])).nullspace()
+    changes = [_change(c, field, states, discrete) for c in candidates]
+    try:
+        polynomials = AtomTable(states).polynomials(changes)
+    except P.NotPolynomial:  # (a power with a symbolic exponent inside an atom's argument)
+        return []
+    rows = sorted({m for p in polynomials for m in p})
+    if not rows:  # every candidate is conserved (f = 0, or the identity map)
+        return list(candidates)
+    table = [_integer_row([p.get(m, Fraction(0)) for p in polynomials]) for m in rows]
+    space, count = flint.fmpz_mat(len(rows), len(candidates), sum(table, [])).nullspace()
     found = []
     for k in range(count):
-        vector = [Fraction(int(space[j, k])) for j in range(len(basis))]
-        top = max(abs(v) for v in vector)
-        found.append({m: v / top for m, v in zip(basis, vector) if v})
+        weights = [Fraction(int(space[j, k])) for j in range(len(candidates))]
+        top = max(abs(w) for w in weights)
+        found.append(E.add(*(E.mul(E.Num(w / top), c)
+                             for w, c in zip(weights, candidates) if w)))
     return found
 
 
+def _change(function: E.Expr, field, states, discrete: bool) -> E.Expr:
+    if discrete:
+        return E.add(calculus.compose(function, states, field), E.neg(function))
+    return calculus.lie_derivative(function, states, field)
+
+
 def _integer_row(row: list[Fraction]) -> list[int]:
-    scale = np.lcm.reduce([v.denominator for v in row]) if row else 1
-    return [int(v * int(scale)) for v in row]
+    scale = int(np.lcm.reduce([v.denominator for v in row])) if row else 1
+    return [int(v * scale) for v in row]
 
 
 def _samples(plan: Plan, extra):
@@ -133,16 +156,15 @@ def _samples(plan: Plan, extra):
     return inside.reshape(-1, len(plan.states)), outside.reshape(-1, len(plan.states))
 
 
-def _separating(basis, inside: np.ndarray, outside: np.ndarray):
+def _separating(basis, states, inside: np.ndarray, outside: np.ndarray):
     """(B exact, margin): sum a_k H_k + c <= -e on `inside`, >= e on `outside`, with
     |a_k| <= 1 and the largest e <= 1 (a linear program); None where e is not positive."""
     from scipy.optimize import linprog
-    values_in = np.column_stack([_values(h, inside) for h in basis])
-    values_out = np.column_stack([_values(h, outside) for h in basis])
+    values_in = np.column_stack([_values(h, states, inside) for h in basis])
+    values_out = np.column_stack([_values(h, states, outside) for h in basis])
     k = len(basis)
     # variables a_1..a_k, c, e; minimise -e
-    upper = np.vstack([np.hstack([values_in, np.ones((len(inside), 1)),
-                                  np.ones((len(inside), 1))]),
+    upper = np.vstack([np.hstack([values_in, np.ones((len(inside), 2))]),
                        np.hstack([-values_out, -np.ones((len(outside), 1)),
                                   np.ones((len(outside), 1))])])
     cost = np.zeros(k + 2)
@@ -153,16 +175,14 @@ def _separating(basis, inside: np.ndarray, outside: np.ndarray):
     if solution.status != 0 or solution.x[-1] <= MIN_MARGIN:
         return None
     a, c = solution.x[:k], solution.x[k]
-    b = P.add(*(P.scale(h, _decimal(w)) for h, w in zip(basis, a)),
-              P.constant(_decimal(c), len(inside[0])))
+    b = E.add(*(E.mul(E.Num(_decimal(w)), h) for h, w in zip(basis, a)), E.Num(_decimal(c)))
     return b, float(solution.x[-1])
 
 
-def _values(h: P.Polynomial, points: np.ndarray) -> np.ndarray:
-    total = np.zeros(len(points))
-    for monomial, coefficient in h.items():
-        total += float(coefficient) * np.prod(points ** np.asarray(monomial), axis=1)
-    return total
+def _values(h: E.Expr, states, points: np.ndarray) -> np.ndarray:
+    with np.errstate(all="ignore"):
+        value = evaluate(h, state_env(states, points))
+    return np.broadcast_to(np.asarray(value, dtype=float), (len(points),))
 
 
 def _decimal(value: float) -> Fraction:

@@ -17,6 +17,7 @@ from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.atoms import folded
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.ir.numbers import rational
 from fossil_dsl.plan.compile import Plan
@@ -268,7 +269,8 @@ class Cegis:
             query = L.substitute(self.plan.query(condition), mapping)
             queries[condition.name] = query
             budget = max(1.0, min(self.options.query_timeout, self.deadline - time.monotonic()))
-            answer = _decided(query) or self.backend.check(query, self.states, budget)
+            answer = _decided(query, self.states) or \
+                self.backend.check(query, self.states, budget)
             verdicts.append(_verdict(condition.name, answer, self.states))
         return tuple(verdicts), queries, time.monotonic() - started
 
@@ -303,11 +305,12 @@ def _counterexamples(record: IterationRecord) -> frozenset:
                      if v.status is Status.SAT)
 
 
-def _decided(query: L.Formula) -> Answer | None:
-    """UNSAT where the query's comparisons between numbers make it false (a conserved
-    B's dB/dt > 0 is 0 > 0, which a delta-decision procedure reads as satisfiable)."""
-    return Answer(Status.UNSAT, solver="exact arithmetic") if L.truth(query) is False \
-        else None
+def _decided(query: L.Formula, states) -> Answer | None:
+    """UNSAT where comparisons whose sides differ by a number make the query false (a
+    conserved B's dB/dt > 0 is 0 > 0, which a delta-decision procedure reads as
+    satisfiable within its tolerance)."""
+    return Answer(Status.UNSAT, solver="exact arithmetic") \
+        if L.truth(folded(query, states)) is False else None
 
 
 def _verdict(name: str, answer: Answer, states) -> Verdict:
