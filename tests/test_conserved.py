@@ -4,6 +4,7 @@ oscillator's safety, which no B that strictly decreases on its zero level set ca
 (the flow preserves area), is certified; a B that does increase is not, by either rule."""
 import json
 from fractions import Fraction
+from pathlib import Path
 
 import fossil_dsl
 from fossil_dsl.engine import first_integral
@@ -11,10 +12,12 @@ from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
-from fossil_dsl.ir.atoms import folded
+from fossil_dsl.ir.atoms import folded, over_atoms
 from fossil_dsl.kernel import Claim, judge
 from fossil_dsl.outputs.recheck import recheck
 from fossil_dsl.plan.compile import compile_spec
+
+ROOT = Path(__file__).resolve().parent.parent
 
 OSCILLATOR = """\
 state x, y
@@ -148,11 +151,37 @@ def test_an_undamped_pendulums_safety_is_certified_with_its_energy():
     assert non_increasing.procedure == "exact arithmetic"
 
 
+def test_lotka_volterra_is_certified_with_its_logarithmic_integral():
+    text = (ROOT / "specs/probe37/s06_lotka_volterra_safety.fsl").read_text()
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=60)
+    assert result.certified, result.summary()
+    assert "log(x)" in E.to_text(result.formulas["B"])
+    assert result.kernel.strengthened == "never leaves D"
+
+
+def test_a_division_by_states_cancels_and_by_other_polynomials_does_not():
+    x, y = E.Var("x"), E.Var("y")
+    quotient, atoms = over_atoms(E.div(E.mul(x, x, y), E.mul(x, E.power(y, E.Num(2)))),
+                                 ["x", "y"])
+    assert atoms == [] and quotient == {(1, 0, 0, 1): Fraction(1)}  # x * y^-1
+    # x / (x + 1) - 1 is not a number: no cancellation through a sum
+    difference = E.add(E.div(x, E.add(x, E.ONE)), E.Num(-1))
+    assert folded(L.Compare(">", difference, E.ZERO), ["x", "y"]) == \
+        L.Compare(">", difference, E.ZERO)
+
+
+def test_false_properties_of_conservative_systems_are_not_certified():
+    for name in ("f18_pendulum_over_the_top", "f19_rigid_body_spin_transfer"):
+        text = (ROOT / f"specs/false/{name}.fsl").read_text()
+        result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=10, max_iters=3)
+        assert not result.certified, name
+
+
 def test_an_outward_spiral_is_not_certified():
     plan = compile_spec(fossil_dsl.loads(SPIRAL))
     assert first_integral.applies(plan)
     assert first_integral.search(plan, float("inf")) is None  # nothing is conserved
-    result = fossil_dsl.synthesise(fossil_dsl.loads(SPIRAL), timeout=20, max_iters=5)
+    result = fossil_dsl.synthesise(fossil_dsl.loads(SPIRAL), timeout=10, max_iters=3)
     assert not result.certified
 
 

@@ -1,14 +1,16 @@
 """Conserved quantities as barriers, for safety.
 
-The combinations H of a few functions (the monomials of degree 1..d, and sin and cos of
-each argument of a sin or cos in the field) with dH/dt = 0 along x' = f(x) (H(f(x)) =
+The combinations H of a few functions (the monomials of degree 1..d, sin and cos of each
+argument of a sin or cos in the field, log of each state positive on D) with dH/dt = 0 along x' = f(x) (H(f(x)) =
 H(x) for a map) form a linear space: written over the states and the field's atoms as
 indeterminates (ir/atoms.py), the conditions are linear equations in H's coefficients
 with rational entries, so the space is found exactly (python-flint's integer null
 space); a combination whose change is 0 over independent indeterminates is 0 for every
-value they take. An undamped pendulum's energy y^2 - 2 cos(x) is one. B = sum_k a_k H_k + c is then chosen by a linear
-program on samples (B <= -e on I, B >= e on U within D, largest e); a and c are rounded,
-and B stays exactly conserved whatever the rounding. In continuous time no B can
+value they take. An undamped pendulum's energy y^2 - 2 cos(x) is one.
+
+B = sum_k a_k H_k + c is then chosen by a linear program on samples (B <= -e on I,
+B >= e on U within D, largest e); a and c are rounded, and B stays exactly conserved
+whatever the rounding. In continuous time no B can
 strictly decrease on its zero level set where the flow conserves volume (an undamped
 oscillator), so such a B is proved by the kernel's variant rule "B never increases in
 D" (kernel/safety_rules.py); a map's rule is met as it is.
@@ -37,8 +39,8 @@ from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan, default_synthesis
 
-DEGREES = (2, 4)  # of the conserved polynomials, in the order tried
-MAX_BASIS = 130  # monomials in H, at most (4 states, degree 4: 69)
+DEGREES = (2, 4)  # of the monomials among the candidates, in the order tried
+MAX_BASIS = 130  # candidates, at most (4 states, degree 4: 69 monomials)
 SAMPLES = 400  # of I and of U within D
 DECIMALS = 6  # kept of a and c
 MIN_MARGIN = 1e-6
@@ -50,7 +52,7 @@ class ConservedFinding:
     controller: dict  # input -> exact constant (empty without inputs)
     operating: np.ndarray
     gain: np.ndarray  # 0: no feedback
-    count: int  # conserved polynomials found (a basis of the space)
+    count: int  # conserved functions found (a basis of the space)
     degree: int
     margin: float
     seconds: float
@@ -58,9 +60,8 @@ class ConservedFinding:
     def describe(self) -> str:
         held = " with the inputs held at the operating point" if self.controller else ""
         return (f"a conserved quantity{held}: B in the span of {self.count} first "
-                f"integrals (monomials of degree <= {self.degree}, sin, cos; exact null "
-                f"space), margin "
-                f"{self.margin:.3g} on the samples, {self.seconds:.2f} s")
+                f"integrals (monomials of degree <= {self.degree}, sin, cos, log; exact null "
+                f"space), margin {self.margin:.3g} on the samples, {self.seconds:.2f} s")
 
 
 def applies(plan: Plan) -> bool:
@@ -82,9 +83,11 @@ def search(plan: Plan, deadline: float, extra=None) -> ConservedFinding | None:
     held = {u: E.Num(Fraction(str(round(float(v), plan.options.digits))))
             for u, v in zip(spec.inputs, operating)}
     field = [traversal.substitute(f, held) for f in spec.dynamics]
+    box = spec.domain.bounding_box()
+    positive = [s for s, low in zip(states, box[0]) if low > 0] if box else []
     samples = None
     for degree in DEGREES:
-        candidates = _candidates(field, states, degree)
+        candidates = _candidates(field, states, degree, positive)
         if time.monotonic() > deadline or len(candidates) > MAX_BASIS:
             return None
         basis = conserved(candidates, field, states, spec.time is TimeDomain.DISCRETE)
@@ -99,14 +102,16 @@ def search(plan: Plan, deadline: float, extra=None) -> ConservedFinding | None:
     return None
 
 
-def _candidates(field, states, degree: int) -> list[E.Expr]:
-    """The monomials of degree 1..degree, then sin and cos of each argument of a sin or
-    cos in the field."""
+def _candidates(field, states, degree: int, positive=()) -> list[E.Expr]:
+    """The monomials of degree 1..degree, sin and cos of each argument of a sin or cos
+    in the field, and the log of each state that is positive throughout the domain (a
+    Lotka-Volterra system conserves x - log(x) + y - log(y))."""
     monomials = [E.mul(*(E.power(E.Var(s), E.Num(k)) for s, k in zip(states, m) if k))
                  for m in P.monomials(len(states), 1, degree)]
     arguments = dict.fromkeys(node.arg for f in field for node in E.walk(f)
                               if isinstance(node, E.Apply) and node.func in ("sin", "cos"))
-    return monomials + [E.apply(func, a) for a in arguments for func in ("sin", "cos")]
+    return monomials + [E.apply(func, a) for a in arguments for func in ("sin", "cos")] + \
+        [E.apply("log", E.Var(s)) for s in positive]
 
 
 def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:

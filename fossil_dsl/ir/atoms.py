@@ -17,6 +17,7 @@ from typing import Sequence
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir import traversal
 
 _POLYNOMIAL_NODES = (E.Num, E.Var, E.Add, E.Mul, E.Neg)
 # larger sides are left to the procedures: expanding a network's derivative over its
@@ -25,18 +26,66 @@ MAX_NODES = 500
 
 
 class AtomTable:
-    """One indeterminate per distinct atom, shared by every expression given."""
+    """One indeterminate per distinct atom, shared by every expression given. A division
+    by a product of states' powers is a product with their inverses, indeterminates
+    of their own that cancel against the states (x * x^-1 = 1): the Laurent polynomials
+    are a ring, so a difference that is 0 there is 0 wherever it is defined (x' / x for
+    x' = x (1 - y) is 1 - y: the derivative of log(x) in a Lotka-Volterra system)."""
 
     def __init__(self, states: Sequence[str]):
         self.states = list(states)
         self.atoms: dict[E.Expr, E.Var] = {}
+        self.inverses: dict[str, E.Var] = {}
 
     def polynomials(self, expressions) -> list[P.Polynomial]:
-        """Each expression as a polynomial in the states, then the atoms (in order of
-        first appearance)."""
-        replaced = [_replace_atoms(e, self.states, self.atoms) for e in expressions]
-        names = self.states + [v.name for v in self.atoms.values()]
-        return [P.polynomial(e, names) for e in replaced]
+        """Each expression as a polynomial in the states, the atoms (in order of first
+        appearance) and the states' inverses."""
+        replaced = [self._replace(e) for e in expressions]
+        names = self.states + [v.name for v in self.atoms.values()] + \
+            [v.name for v in self.inverses.values()]
+        pairs = [(self.states.index(s), names.index(v.name)) for s, v in self.inverses.items()]
+        return [_cancelled(P.polynomial(e, names), pairs) for e in replaced]
+
+    def _replace(self, expr: E.Expr) -> E.Expr:
+        if isinstance(expr, E.Div):
+            inverse = self._inverse(expr.denominator)
+            if inverse is not None:
+                return E.mul(self._replace(expr.numerator), inverse)
+        if _is_atom(expr, self.states):
+            if expr not in self.atoms:
+                self.atoms[expr] = E.Var(f"@atom{len(self.atoms)}")
+            return self.atoms[expr]
+        if isinstance(expr, (E.Add, E.Mul, E.Neg, E.Pow)):
+            return traversal.rebuild(expr, tuple(self._replace(c) for c in E.children(expr)))
+        return expr
+
+    def _inverse(self, denominator: E.Expr) -> E.Expr | None:
+        """1 / denominator where it is a number or a product of states' natural powers."""
+        if isinstance(denominator, E.Num):
+            return E.Num(1 / denominator.value) if denominator.value != 0 else None
+        if isinstance(denominator, E.Var) and denominator.name in self.states:
+            name = denominator.name
+            return self.inverses.setdefault(name, E.Var(f"@inverse:{name}"))
+        if isinstance(denominator, E.Pow) and not _is_atom(denominator, self.states):
+            base = self._inverse(denominator.base)
+            return None if base is None else E.power(base, denominator.exponent)
+        if isinstance(denominator, E.Mul):
+            factors = [self._inverse(f) for f in denominator.factors]
+            return None if None in factors else E.mul(*factors)
+        return None
+
+
+def _cancelled(polynomial: P.Polynomial, pairs) -> P.Polynomial:
+    """x^a (x^-1)^b as x^(a-b) or (x^-1)^(b-a), for each (state, inverse) place pair."""
+    terms = []
+    for monomial, coefficient in polynomial.items():
+        exponents = list(monomial)
+        for state, inverse in pairs:
+            common = min(exponents[state], exponents[inverse])
+            exponents[state] -= common
+            exponents[inverse] -= common
+        terms.append({tuple(exponents): coefficient})
+    return P.add(*terms)
 
 
 def over_atoms(expr: E.Expr, states: Sequence[str]) -> tuple[P.Polynomial, list[E.Expr]]:
@@ -79,21 +128,3 @@ def _is_atom(node: E.Expr, states) -> bool:
         return not (isinstance(exponent, E.Num) and exponent.value.denominator == 1
                     and exponent.value >= 0)
     return not isinstance(node, _POLYNOMIAL_NODES)
-
-
-def _replace_atoms(expr: E.Expr, states, atoms: dict) -> E.Expr:
-    if _is_atom(expr, states):
-        if expr not in atoms:
-            atoms[expr] = E.Var(f"@atom{len(atoms)}")
-        return atoms[expr]
-    if isinstance(expr, E.Add):
-        return E.Add(tuple(_replace_atoms(t, states, atoms) for t in expr.terms))
-    if isinstance(expr, E.Mul):
-        return E.Mul(tuple(_replace_atoms(f, states, atoms) for f in expr.factors))
-    if isinstance(expr, E.Neg):
-        return E.Neg(_replace_atoms(expr.operand, states, atoms))
-    if isinstance(expr, E.Div):  # by a number
-        return E.Div(_replace_atoms(expr.numerator, states, atoms), expr.denominator)
-    if isinstance(expr, E.Pow):  # a natural power
-        return E.Pow(_replace_atoms(expr.base, states, atoms), expr.exponent)
-    return expr
