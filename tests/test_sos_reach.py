@@ -1,12 +1,19 @@
 """The sum-of-squares attempt for reach-type properties (engine/sos_reach.py): V (and B)
 from a semidefinite program, with a controller fixed to an LQR gain where there are
 inputs, proved like any candidate."""
+from fractions import Fraction
+from pathlib import Path
+
 import sympy
 
 import fossil_dsl
 from fossil_dsl.engine import sos_reach
+from fossil_dsl.engine.rational_field import over_one_denominator
+from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.plan.compile import compile_spec
+
+ROOT = Path(__file__).resolve().parent.parent
 
 # I on the left, the unsafe box on the right, both further from the origin than G: every
 # ellipsoid round the origin that holds I reaches x0 = 1.5 > 1.2 (I is symmetric to a set
@@ -154,3 +161,21 @@ def test_remaining_in_f_for_ever_needs_f_inside_the_interior_of_d():
         GIVEN_RAR.replace("FINAL", "box([-2, -0.6], [0.6, 0.6])")), timeout=60)
     assert touching.certified and touching.kernel.strengthened is None
     assert "while it stays in D" in touching.guarantee()
+
+
+def test_a_rational_field_is_multiplied_through_by_its_positive_denominator():
+    text = (ROOT / "specs/probe36/r07_rational_rwa.fsl").read_text()
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+
+
+def test_a_denominator_that_changes_sign_on_the_domain_gives_no_program():
+    x, y = E.Var("x0"), E.Var("x1")
+    box = ((-2, -2), (2, 2))
+    positive = [y, E.div(E.neg(x), E.add(E.ONE, E.power(x, E.Num(2))))]
+    numerators, denominator = over_one_denominator(positive, ["x0", "x1"], box)
+    assert denominator == {(0, 0): 1, (2, 0): 1}  # 1 + x0^2
+    assert numerators[0] == {(0, 1): 1, (2, 1): 1} and numerators[1] == {(1, 0): -1}
+    changing = [y, E.div(E.neg(x), E.add(E.Num(Fraction(1, 2)), E.neg(x)))]  # 1/2 - x0
+    assert over_one_denominator(changing, ["x0", "x1"], box) is None

@@ -1,5 +1,6 @@
 """A sum-of-squares attempt for reach-type properties (reach, RWA, RAR) of a polynomial
-ODE; where the system has inputs, with a linear controller fixed beforehand to an LQR
+ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where the decrease
+is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py); where the system has inputs, with a linear controller fixed beforehand to an LQR
 gain of its linearisation, rounded as the verifier will see it.
 
 V (a polynomial of degree 2 or 4, coefficients in [-100, 100]) and the largest e with
@@ -26,6 +27,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.engine.sos import Inexact, interval_products, set_constraints
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
 from fossil_dsl.ir import expr as E
@@ -68,12 +70,12 @@ class ReachFinding:
 
 
 def applies(plan: Plan) -> bool:
-    """A polynomial ODE, a reach-type property, the default templates, and at most a
-    linear controller (the default one)."""
+    """A polynomial or rational ODE, a reach-type property, the default templates, and
+    at most a linear controller (the default one)."""
     spec = plan.spec
     return (plan.certificate.form in FORMS and spec.time is TimeDomain.CONTINUOUS
             and default_synthesis(plan)
-            and _polynomial(spec.dynamics, spec.states + spec.inputs) is not None)
+            and all(traversal.is_arithmetic(f) for f in spec.dynamics))
 
 
 def search(plan: Plan, deadline: float) -> ReachFinding | None:
@@ -89,12 +91,19 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     except Inexact:
         return None
     rng = np.random.default_rng(plan.options.seed)
+    box = spec.domain.bounding_box()
     for controller, gain in _controllers(plan, operating, rng):
-        field = _polynomial([traversal.substitute(f, controller) for f in spec.dynamics],
-                            states)
-        if field is None or time.monotonic() > deadline:
+        closed = [traversal.substitute(f, controller) for f in spec.dynamics]
+        field = _polynomial(closed, states)
+        denominator = P.constant(1, len(states))
+        if field is None:  # a rational field: the programs are multiplied through by Q
+            found = over_one_denominator(closed, states, box, plan.options.seed)
+            if found is None or pieces.outside_final is not None:
+                continue  # (RAR's barrier program is for polynomial fields)
+            field, denominator = found
+        if time.monotonic() > deadline:
             continue
-        found = _functions(len(states), field, pieces, deadline)
+        found = _functions(len(states), field, denominator, pieces, deadline)
         if found is not None:
             formulas, degree, margin = found
             return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
@@ -176,8 +185,9 @@ class _Pieces:
                 for g in _constraints(region, states)]
 
 
-def _functions(n: int, field, pieces: _Pieces, deadline: float):
-    """({"V": V, "B": B for RAR}, V's degree, margin) or None."""
+def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float):
+    """({"V": V, "B": B for RAR}, V's degree, margin) or None; the field is
+    field / denominator (denominator > 0 on D)."""
     b = None
     if pieces.outside_final is not None:
         b = _barrier(n, field, pieces, deadline)
@@ -186,7 +196,7 @@ def _functions(n: int, field, pieces: _Pieces, deadline: float):
     for half in HALF_DEGREES:
         if time.monotonic() > deadline:
             return None
-        program = _ReachProgram(n, field, pieces, half)
+        program = _ReachProgram(n, field, denominator, pieces, half)
         if program.count > MAX_VARIABLES:
             return None
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
@@ -212,7 +222,7 @@ def _barrier(n: int, field, pieces: _Pieces, deadline: float):
 
 
 class _ReachProgram(Program):
-    def __init__(self, n: int, field, pieces: _Pieces, half: int):
+    def __init__(self, n: int, field, denominator, pieces: _Pieces, half: int):
         super().__init__(n)
         self.basis = P.monomials(n, 0, 2 * half)
         self.coefficients = [self.scalar() for _ in self.basis]
@@ -227,8 +237,8 @@ class _ReachProgram(Program):
             self.require(list(zip(self.coefficients, terms)), piece)
         decrease = [(v, P.scale(P.lie_derivative(t, field), -1))
                     for v, t in zip(self.coefficients, terms)]
-        for piece in pieces.outside_goal:
-            self.require(decrease, piece, P.constant(-GAMMA, n))
+        for piece in pieces.outside_goal:  # grad V . N <= -γ Q, that is dV/dt <= -γ
+            self.require(decrease, piece, P.scale(denominator, -GAMMA))
 
     def require(self, terms, constraints, constant=None) -> None:
         """sum of terms (+ constant) - e = s + sum_i sigma_i g_i, as one identity."""
@@ -237,7 +247,8 @@ class _ReachProgram(Program):
         if constant:
             self.add_constant(constant)
         self.add_term(self.margin, P.constant(-1, self.n))
-        top = max([2] + [P.degree(p) for _, p in terms] + [P.degree(g) for g in constraints])
+        top = max([2, P.degree(constant or {})] + [P.degree(p) for _, p in terms]
+                  + [P.degree(g) for g in constraints])
         self.minus_certificate((top + 1) // 2, constraints, low=0)
         self.new_identity()
 
