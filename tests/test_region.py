@@ -3,6 +3,7 @@ the learned V, and how much of D and of the simulated basin its region covers.""
 from __future__ import annotations
 
 import json
+import time
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
@@ -12,7 +13,7 @@ import numpy as np
 import fossil_dsl
 from fossil_dsl.engine.evaluate import evaluate
 from fossil_dsl.engine.region import largest_level
-from fossil_dsl.kernel import Claim, judge, list_obligations
+from fossil_dsl.kernel import Claim, judge, list_obligations, verdict
 from fossil_dsl.outputs.recheck import recheck
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -118,6 +119,19 @@ def test_the_kernel_grants_a_level_only_inside_the_basin():
     assert small.certified and "asymptotically stable" in small.guarantee
     assert "from I" not in small.guarantee
     assert not judge(_vdp_claim(spec, Fraction(7))).certified
+
+
+def test_a_judge_past_its_deadline_gives_each_obligation_a_moment_only():
+    spec = fossil_dsl.check_text(VDP_NO_INITIAL, "vdp.fsl").spec
+    claim = _vdp_claim(spec, Fraction(1, 2))
+    started = time.monotonic()
+    late = judge(claim, timeout=60, deadline=started - 1)
+    seconds = time.monotonic() - started
+    count = len(list_obligations(claim))
+    # each obligation had at most LAST_SECONDS (and a little for the procedures to stop)
+    assert seconds < count * (verdict.LAST_SECONDS + 1.5), seconds
+    if late.certified:  # the quick proofs stand: only time was taken away
+        assert late.guarantee == judge(claim).guarantee
 
 
 def test_an_unstable_origin_is_not_certified_with_a_region():

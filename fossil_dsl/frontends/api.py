@@ -56,11 +56,11 @@ def _largest(plan: Plan, outcome, verdict: Verdict, pieces, started: float):
     deadline = started + plan.options.timeout
 
     def judge_at(claim):
-        # each obligation gets at most what is left of the run (a level judged past the
-        # deadline overran a 120 s run by 15 s)
-        left = max(1.0, deadline - time.monotonic())
-        return judge(claim, timeout=min(plan.options.query_timeout, left),
-                     delta=plan.options.delta, pieces=pieces)
+        # the obligations together get at most what is left of the run (a level judged
+        # past the deadline overran a 120 s run by 15 s; with a per-obligation bound,
+        # by 3 s)
+        return judge(claim, timeout=plan.options.query_timeout, delta=plan.options.delta,
+                     pieces=pieces, deadline=deadline)
     found = largest_level(claim_of(plan, outcome), verdict, judge_at, deadline,
                           plan.options.seed)
     candidate = replace(outcome.candidate,

@@ -18,6 +18,7 @@ from fossil_dsl.kernel.prove import Outcome, Proof, discharge
 _SEAL = object()
 OBLIGATION_TIMEOUT = 60.0  # seconds per obligation; running out is "not proved"
 STRENGTHENING_TIMEOUT = 20.0  # per further obligation of an optional strengthening
+LAST_SECONDS = 0.5  # for each obligation once a judge's deadline has passed
 
 
 @dataclass(frozen=True)
@@ -52,32 +53,27 @@ def list_obligations(claim: Claim, strengthened: str | None = None,
 
 
 def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
-          delta: float | None = None, pieces=None) -> Verdict:
+          delta: float | None = None, pieces=None, deadline: float | None = None) -> Verdict:
     """Prove every obligation of the main rule, stopping at the first that is not
     proved; where one is not, the same for each variant of the rule (an obligation they
     share is proved once). `pieces` checks the pieces of split interval queries in
-    parallel (their cover is checked here)."""
+    parallel (their cover is checked here). With a `deadline` (time.monotonic()), no
+    obligation gets more than what is left of it (LAST_SECONDS once it has passed):
+    one that needs more is not proved."""
     started = time.monotonic()
     try:
-        variants = rule_variants(claim.spec)
         derive_facts(claim)
     except NoRule as exc:
         return not_certified(f"the kernel cannot judge this claim: {exc}")
-    known: dict[Obligation, Proof] = {}
-    first_failure = None
-    for variant in variants:
-        found, guarantee = derive_facts(claim, variant)
-        proofs, proved = _prove_all(found, claim, timeout, delta, pieces, known)
-        if proved:
-            break
-        first_failure = first_failure or proofs  # the main rule's failure is reported
+    proved, proofs, variant, guarantee = _first_rule_proved(
+        claim, _Budget(timeout, deadline), delta, pieces)
     if not proved:
-        return Verdict(False, _failure_text(first_failure[-1]), tuple(first_failure),
+        return Verdict(False, _failure_text(proofs[-1]), tuple(proofs),
                        time.monotonic() - started)
     strengthened = None
     for option, extra, stronger in derive_strengthenings(claim, variant):
-        more, done = _prove_all(extra, claim, min(timeout, STRENGTHENING_TIMEOUT), delta,
-                                pieces)
+        budget = _Budget(min(timeout, STRENGTHENING_TIMEOUT), deadline)
+        more, done = _prove_all(extra, claim, budget, delta, pieces)
         if done:
             proofs += more
             guarantee, strengthened = stronger, option.name
@@ -86,7 +82,34 @@ def judge(claim: Claim, timeout: float = OBLIGATION_TIMEOUT,
                    time.monotonic() - started, guarantee, strengthened, _SEAL, variant)
 
 
-def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
+def _first_rule_proved(claim: Claim, budget: "_Budget", delta, pieces):
+    """(proved, proofs, variant, guarantee) for the first of the main rule and its
+    variants whose obligations are all proved; else (False, the main rule's proofs up
+    to its first failure, None, "")."""
+    known: dict[Obligation, Proof] = {}
+    first_failure = None
+    for variant in rule_variants(claim.spec):
+        found, guarantee = derive_facts(claim, variant)
+        proofs, proved = _prove_all(found, claim, budget, delta, pieces, known)
+        if proved:
+            return True, proofs, variant, guarantee
+        first_failure = first_failure or proofs
+    return False, first_failure, None, ""
+
+
+class _Budget:
+    """Seconds for the next obligation: the timeout, or what is left of the deadline."""
+
+    def __init__(self, timeout: float, deadline: float | None):
+        self.timeout, self.deadline = timeout, deadline
+
+    def seconds(self) -> float:
+        if self.deadline is None:
+            return self.timeout
+        return min(self.timeout, max(LAST_SECONDS, self.deadline - time.monotonic()))
+
+
+def _prove_all(obligations: list[Obligation], claim: Claim, timeout: _Budget,
                delta: float | None, pieces=None,
                known: dict | None = None) -> tuple[list[Proof], bool]:
     """The proofs up to the first obligation not proved, and whether all were proved.
@@ -98,9 +121,9 @@ def _prove_all(obligations: list[Obligation], claim: Claim, timeout: float,
         if obligation not in known:
             first = claim.procedures.get(obligation.name.removeprefix("condition:"),
                                          obligation.first)
-            known[obligation] = discharge(obligation, claim.spec.states, timeout, delta,
-                                          first, claim.refutations.get(obligation.name),
-                                          pieces)
+            known[obligation] = discharge(obligation, claim.spec.states, timeout.seconds(),
+                                          delta, first,
+                                          claim.refutations.get(obligation.name), pieces)
         proofs.append(known[obligation])
         if not proofs[-1].proved:
             return proofs, False
