@@ -4,9 +4,12 @@ Lyapunov function and, with inputs, its LQR gain, for several LQR weightings
 seed is rounded and verified like any candidate."""
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
-from fossil_dsl.engine.linear import (STABLE_FORMS, holds_a_quadratic, is_linear,
+from fossil_dsl.engine.ellipsoid_seed import ellipsoid
+from fossil_dsl.engine.linear import (STABLE_FORMS, holds_a_quadratic, is_linear, jacobians,
                                       lyapunov_matrix, separation, set_linear, set_quadratic)
 from fossil_dsl.engine.networks import Network
 from fossil_dsl.engine.quadratic_shapes import lqr_gains
@@ -34,13 +37,36 @@ def candidates(plan, networks: dict[str, Network], controller: Network | None,
 
 
 def _seeds(plan, networks, controller, samples):
-    """One at a time: the weightings after the first are solved only when it fails."""
+    """One at a time: the weightings after the first are solved only when it fails.
+    For a region of attraction, after the identity weights and before the others, the
+    ellipsoid between I and D that the linearised closed loop keeps
+    (ellipsoid_seed.py), with its own gain."""
     discrete = plan.spec.time is TimeDomain.DISCRETE
     rng = np.random.default_rng(plan.options.seed)
-    for A, K in lqr_gains(plan.spec, controller is not None, None, rng):
-        P = lyapunov_matrix(A, discrete)
-        if P is not None:
-            yield True, _quadratic_setter(networks, controller, samples, P, K)
+    gains = lqr_gains(plan.spec, controller is not None, None, rng)
+    for A, K in itertools.islice(gains, 1):  # the identity weights
+        yield from _lqr_seed(networks, controller, samples, A, K, discrete)
+    yield from _ellipsoid_seed(plan, networks, controller, samples, discrete)
+    for A, K in gains:
+        yield from _lqr_seed(networks, controller, samples, A, K, discrete)
+
+
+def _lqr_seed(networks, controller, samples, A, K, discrete: bool):
+    P = lyapunov_matrix(A, discrete)
+    if P is not None:
+        yield True, _quadratic_setter(networks, controller, samples, P, K)
+
+
+def _ellipsoid_seed(plan, networks, controller, samples, discrete: bool):
+    found = jacobians(plan.spec) if plan.spec.property.form != "stability" else None
+    if found is None:
+        return
+    A, B = found
+    found = ellipsoid(A, B if controller is not None else np.zeros((len(A), 0)), plan.spec,
+                      discrete)
+    if found is not None:
+        P, gain = found
+        yield True, _quadratic_setter(networks, controller, samples, P, -gain)
 
 
 def _quadratic_setter(networks, controller, samples, P: np.ndarray, K):
