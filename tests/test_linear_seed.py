@@ -1,8 +1,12 @@
 """The linearisation's quadratic Lyapunov function and LQR gain as the networks' start."""
+import itertools
+from pathlib import Path
+
 import numpy as np
 import torch
 
 import fossil_dsl
+from fossil_dsl.engine.ellipsoid_seed import ellipsoid
 from fossil_dsl.engine.learner import Learner
 from fossil_dsl.engine.linear import jacobians, local_certificate
 from fossil_dsl.plan.compile import compile_spec
@@ -102,3 +106,43 @@ def test_a_controller_seed_is_chosen_among_lqr_weightings_where_identity_fails()
     assert not np.allclose(gain, -K.ravel(), atol=1e-3)  # not the identity weights' gain
     result = fossil_dsl.synthesise(fossil_dsl.loads(MOORE_GREITZER), timeout=60)
     assert result.certified, result.summary()
+
+
+# a cart-pole's upright pose, without the cart's position (probe37/s11): the identity
+# LQR weights' ellipsoids are flat, and every one that holds I leaves D
+CART_POLE = (Path(__file__).resolve().parent.parent
+             / "specs/probe37/s11_cart_pole_ctrl.fsl").read_text()
+
+
+def test_the_ellipsoid_seed_holds_i_lies_in_d_and_decays():
+    spec = fossil_dsl.loads(CART_POLE)
+    A, B = jacobians(spec)
+    P, K = ellipsoid(A, B, spec, discrete=False)
+    corners = np.array(list(itertools.product((-0.1, 0.1), repeat=3)))
+    assert np.einsum("ij,jk,ik->i", corners, P, corners).max() <= 1 + 1e-6
+    # the smallest x^T P x on the face x_i = d_i is d_i^2 / (P^-1)_ii
+    Q, half_widths = np.linalg.inv(P), np.array([1.0, 0.5, 1.0])
+    assert (half_widths ** 2 / np.diag(Q)).min() > 1
+    closed = A + B @ K
+    assert np.linalg.eigvalsh(closed.T @ P + P @ closed).max() < 0
+    # where the identity weights' quadratic cannot fit between I and D
+    P_lqr, _ = local_certificate(spec, True, np.zeros(1))
+    inside = np.einsum("ij,jk,ik->i", corners, P_lqr, corners).max()
+    assert (half_widths ** 2 / np.diag(np.linalg.inv(P_lqr))).min() < inside
+
+
+def test_a_region_of_attraction_whose_lqr_ellipsoid_leaves_d_is_certified():
+    text = """\
+state x, y
+input u
+dynamics continuous {
+    x' = y
+    y' = u + x^3/10
+}
+domain box([-1, -1], [1, 1])
+set init = box([-0.5, -0.5], [0.5, 0.5])
+prove from init: stable
+"""
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=60)
+    assert result.certified, result.summary()
+    assert result.iterations == 1  # the seed itself, nothing learned

@@ -26,28 +26,35 @@ from fossil_dsl.solvers.sdp import Program
 # a (continuous time) and r (maps), the strongest feasible first: a margin in the decrease
 # is what the verifier needs (a cart-pole's decrease with a = 0.1 was left UNKNOWN after
 # 60 s; with a = 1, dV/dt <= -1.8 V on the samples)
-DECAYS = (3.0, 1.0, 0.3, 0.1)
+DECAYS = (3.0, 1.0, 0.5, 0.3, 0.1)
 CONTRACTIONS = (0.7, 0.85, 0.95)
 GAIN_WEIGHT = 1e-3  # w: how much a small |u| counts against a small ellipsoid
 MAX_CORNERS = 256  # I's box in at most 8 states
 SECONDS = 5.0  # for the solver
+# s at most this: the sampled level between I and D needs room (with a = 1 a cart-pole's
+# ellipsoid filled 95 % of D's box, and the level chosen from samples fell below I's
+# corners: an iteration lost); else the feasible one with the smallest s
+ROOM = 0.8
 
 
 def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
-    """(P, K) with u = K x, or None where the sets are not boxes or balls round the
+    """(P, K) with u = K x for the strongest rate whose s is at most ROOM (else the
+    weakest feasible one), or None where the sets are not boxes or balls round the
     origin's neighbourhood, or the inequalities are infeasible, or s >= 1."""
     half_widths = _half_widths(spec.domain, len(A))
     corners = _corners(spec.property.role("initial"), len(A))
     if half_widths is None or corners is None:
         return None
+    last = None
     for rate in CONTRACTIONS if discrete else DECAYS:
         try:
             found = _solve(A, B, half_widths, corners, discrete, rate)
         except (ValueError, np.linalg.LinAlgError):  # numerical trouble: no seed
             return None
-        if found is not None:
-            return found
-    return None
+        if found is not None and found[2] <= ROOM:
+            return found[:2]
+        last = found or last
+    return None if last is None else last[:2]
 
 
 def _half_widths(domain, n: int) -> np.ndarray | None:
@@ -104,7 +111,7 @@ def _solve(A, B, d, corners, discrete: bool, rate: float):
     Qv = np.array([[_value(Q[i][j], x) for j in range(n)] for i in range(n)])
     Yv = np.array([[_value(Y[l][j], x) for j in range(n)] for l in range(m)])
     P = np.linalg.inv(Qv)
-    return (P + P.T) / 2, Yv @ P
+    return (P + P.T) / 2, Yv @ P, float(x[s])
 
 
 class _Inequalities(Program):
