@@ -49,6 +49,10 @@ def plan_text(plan: Plan, explain: bool = False) -> str:
         radius = plan.origin_radius if plan.excludes_a_ball else Fraction(0)
         lines.append("guarantee, once every obligation is proved: "
                      + guarantee_text(plan.spec, radius, plan.controller is not None))
+        variant = plan.certificate.variant_conditions()
+        if variant is not None:
+            lines.append("or, where the conditions above cannot all be met, the kernel's "
+                         "variant rule with: " + "; ".join(c.text for c in variant))
     return "\n".join(lines)
 
 
