@@ -119,8 +119,9 @@ def _shaped_proof(plan: Plan, finding, backend: Backend, listener, deadline: flo
     lemma = _ball_left_out(plan, finding, radius)
     for attempt in (lemma,) if lemma.origin_radius == radius else \
             (lemma, replace(plan, origin_radius=radius)):
-        given, outcome = _given(attempt, backend, listener, deadline, finding.formula,
-                                BASIN_QUERY_SECONDS, time.monotonic() + BASIN_REFUTING_SECONDS)
+        given, outcome = _given(attempt, backend, listener, deadline,
+                                _only(attempt, finding.formula), BASIN_QUERY_SECONDS,
+                                time.monotonic() + BASIN_REFUTING_SECONDS)
         if outcome.certified or time.monotonic() > deadline:
             break
     return given, outcome
@@ -197,9 +198,9 @@ def _conserved(plan: Plan, backend: Backend, listener, deadline: float):
         prepare = (lambda cegis: _controller_set(cegis, finding)) if finding.controller \
             else None
         try:
-            given, outcome = _given(variant, backend, listener, deadline, finding.formula,
-                                    SOS_QUERY_SECONDS, time.monotonic() + REACH_REFUTING_SECONDS,
-                                    prepare)
+            given, outcome = _given(variant, backend, listener, deadline,
+                                    _only(variant, finding.formula), SOS_QUERY_SECONDS,
+                                    time.monotonic() + REACH_REFUTING_SECONDS, prepare)
         except NotSetUp as exc:
             return None, f"{finding.describe()}: {exc}"
         if outcome.certified:
@@ -249,8 +250,9 @@ def _proved(plan: Plan, backend: Backend, listener, deadline: float, finding,
             formulas: dict | None = None, prepare=None):
     """((plan with the function given, certified outcome) or None, what happened)."""
     try:
-        given, outcome = _given(plan, backend, listener, deadline, formulas or finding.formula,
-                                query_seconds, time.monotonic() + refuting_seconds, prepare)
+        given, outcome = _given(plan, backend, listener, deadline,
+                                formulas or _only(plan, finding.formula), query_seconds,
+                                time.monotonic() + refuting_seconds, prepare)
     except NotSetUp as exc:
         return None, f"{finding.describe()}: {exc}"
     if not outcome.certified:
@@ -260,13 +262,11 @@ def _proved(plan: Plan, backend: Backend, listener, deadline: float, finding,
 
 def _given(plan: Plan, backend: Backend, listener, deadline: float, formulas,
            query_seconds: float, refuting_until: float | None = None, prepare=None):
-    """The plan with the found functions as its candidates (a name -> formula map, or
-    one formula for its one function), and its outcome: proved by refutations of the
+    """The plan with the found functions (name -> formula) as its candidates, and its
+    outcome: proved by refutations of the
     kernel's obligations where they settle every condition, else by the solvers; the
     candidate is verified once (nothing is learned). `prepare(cegis)` sets up the rest
     of the loop (a controller), raising NotSetUp where it cannot."""
-    if not isinstance(formulas, dict):
-        formulas = {f.name: formulas for f in plan.functions}
     given = replace(plan, functions=tuple(replace(f, candidate=formulas[f.name])
                                           for f in plan.functions))
     options = replace(plan.options, query_timeout=min(plan.options.query_timeout,
@@ -280,6 +280,11 @@ def _given(plan: Plan, backend: Backend, listener, deadline: float, formulas,
     if not outcome.certified:
         outcome = _merged(_verified_once(cegis), outcome.refutations)
     return given, outcome
+
+
+def _only(plan: Plan, formula) -> dict:
+    """The formula as the plan's one function (a Lyapunov V, a barrier B)."""
+    return {f.name: formula for f in plan.functions}
 
 
 def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:

@@ -30,6 +30,7 @@ import numpy as np
 
 from fossil_dsl.engine.evaluate import evaluate, state_env
 from fossil_dsl.engine.sampling import sample
+from fossil_dsl.engine.trajectories import column
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
@@ -185,9 +186,7 @@ def _separating(basis, states, inside: np.ndarray, outside: np.ndarray):
 
 
 def _values(h: E.Expr, states, points: np.ndarray) -> np.ndarray:
-    with np.errstate(all="ignore"):
-        value = evaluate(h, state_env(states, points))
-    return np.broadcast_to(np.asarray(value, dtype=float), (len(points),))
+    return column(evaluate(h, state_env(states, points)), len(points))
 
 
 def _decimal(value: float) -> Fraction:

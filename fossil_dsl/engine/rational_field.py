@@ -10,6 +10,8 @@ from fractions import Fraction
 
 import numpy as np
 
+from fossil_dsl.engine.evaluate import evaluate, state_env
+from fossil_dsl.engine.trajectories import column
 from fossil_dsl.ir import polynomials as P
 
 SIGN_SAMPLES = 2000  # points of D's box where Q's sign is looked at
@@ -31,7 +33,7 @@ def over_one_denominator(field, states, box, seed: int = 0):
     except (SympyConversionError, sympy.PolynomialError, ValueError):
         return None
     *numerators, denominator = polynomials
-    sign = _sign(denominator, box, seed)
+    sign = _sign(P.to_expr(denominator, states), states, box, seed)
     if sign == 0:
         return None
     return [P.scale(n, sign) for n in numerators], P.scale(denominator, sign)
@@ -44,13 +46,11 @@ def _polynomial(expression, generators) -> P.Polynomial:
             if c != 0}
 
 
-def _sign(denominator: P.Polynomial, box, seed: int) -> int:
+def _sign(denominator, states, box, seed: int) -> int:
     """1 or -1 where Q has that sign at every sampled point, else 0."""
     if box is None:
         return 0
     low, high = np.asarray(box[0], dtype=float), np.asarray(box[1], dtype=float)
     points = low + (high - low) * np.random.default_rng(seed).random((SIGN_SAMPLES, len(low)))
-    values = sum(float(c) * np.prod(points ** np.asarray(m), axis=1)
-                 for m, c in denominator.items())
-    values = np.broadcast_to(np.asarray(values, dtype=float), (SIGN_SAMPLES,))
+    values = column(evaluate(denominator, state_env(states, points)), SIGN_SAMPLES)
     return 1 if values.min() > 0 else -1 if values.max() < 0 else 0
