@@ -118,3 +118,13 @@ def test_nearly_cancelling_polynomials_are_refuted_by_the_mean_value_form():
     wrapped = L.Compare("<=", E.add(E.Apply("sin", x), E.neg(E.Apply("sin", x)),
                                     expanded, num("0.01")), num(0))
     assert check(*box(-1, 1, x, y), wrapped) is Status.UNSAT
+
+
+def test_a_negated_conjunct_bounds_nothing():
+    # soundness (session 38): "not (x^2 + y^2 <= 1/25)" was read as the ball itself,
+    # so the search covered the ball only and refuted points that lie outside it
+    outside = L.negation(L.Compare("<=", E.add(E.power(x, num(2)), E.power(y, num(2))),
+                                   num(Fraction(1, 25))))
+    query = [*box(-1, 1, x, y), outside]
+    assert starting_box(L.conjunction(*query), ["x", "y"]) == [(-1.0, 1.0), (-1.0, 1.0)]
+    assert check(*query, L.Compare(">=", x, num(Fraction(1, 2)))) is not Status.UNSAT

@@ -6,6 +6,7 @@ from fractions import Fraction
 import fossil_dsl
 from fossil_dsl.ir import expr as E
 from fossil_dsl.kernel.local import negative_near_origin
+from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.kernel.obligations import Claim, Facts
 from fossil_dsl.outputs.recheck import recheck
 
@@ -25,7 +26,10 @@ def candidate(text: str, formula: str) -> str:
 
 
 def test_a_transcendental_system_is_asymptotically_stable_not_only_eps(tmp_path):
-    result = fossil_dsl.synthesise(fossil_dsl.loads(PENDULUM), seed=0, timeout=120)
+    # tan has no polynomial facts (solvers/atom_facts.py): the ball round the origin is
+    # not refuted directly, and the Taylor lemma covers it
+    spec = fossil_dsl.loads(PENDULUM.replace("-sin(x0)", "-tan(x0)"))
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
     assert result.certified, result.reason
     assert result.plan.origin_radius > 0  # the interval verifier left a ball out
     assert result.kernel.strengthened == "no ball left out"
@@ -36,9 +40,22 @@ def test_a_transcendental_system_is_asymptotically_stable_not_only_eps(tmp_path)
     checks = recheck(tmp_path, timeout=10)
     local = [c for c in checks if c.condition.startswith("local-")]
     # exported as derived; none refuted; CVC5 may time out on what only the interval
-    # procedure proves (sin), but the rest is re-proved by another solver
+    # procedure proves (tan), but the rest is re-proved by another solver
     assert local and all(c.status in ("unsat", "unknown") for c in local), local
     assert sum(c.reproved for c in local) >= len(local) - 2, local
+
+
+def test_the_ball_is_proved_directly_where_a_refutation_reaches_it(tmp_path):
+    result = fossil_dsl.synthesise(fossil_dsl.loads(PENDULUM), seed=0, timeout=120)
+    assert result.certified, result.reason
+    assert result.plan.origin_radius > 0
+    assert result.kernel.strengthened == "no ball left out, directly"
+    assert "ε-stability" not in result.guarantee()
+    by_name = {p.obligation.name: p.procedure for p in result.kernel.proofs}
+    assert by_name["ball:decrease"] == by_name["ball:positive"] == SUM_OF_SQUARES
+    result.save(tmp_path)
+    checks = {c.condition: c for c in recheck(tmp_path, timeout=10)}
+    assert checks["ball-decrease"].reproved and checks["ball-positive"].reproved
 
 
 def test_a_function_that_dips_below_zero_inside_the_ball_keeps_the_eps():

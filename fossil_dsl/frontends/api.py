@@ -14,6 +14,7 @@ from fossil_dsl.engine.region import largest_level
 from fossil_dsl.engine.split import SplitBackend
 from fossil_dsl.plan.compile import Plan, compile_spec
 from fossil_dsl.kernel import Verdict, judge, not_certified
+from fossil_dsl.kernel.prove import ATOMS_REFUTATION_FIRST
 from fossil_dsl.outputs.region import region_report
 from fossil_dsl.outputs.result import Result, build_result, claim_of
 from fossil_dsl.solvers import registry
@@ -85,7 +86,9 @@ def _backend(plan: Plan, pieces=None):
     CVC5 joins the race for polynomial problems half a second after the fallback: it
     found at once the counterexample to a 4-state quadratic decrease condition on which
     Z3 and the interval search each spent 30 s without an answer (given the head start
-    over the fallback, it cost the portfolio's reach-type rows 1 to 3 s of verifying)."""
+    over the fallback, it cost the portfolio's reach-type rows 1 to 3 s of verifying).
+    Problems with elementary functions get the refutation first (through the queries'
+    polynomial form) from ATOMS_REFUTATION_FIRST states on, where bisection slows down."""
     from fossil_dsl.solvers.sos_refutation import RefutationFirst
 
     def load(name: str):
@@ -100,4 +103,5 @@ def _backend(plan: Plan, pieces=None):
         if polynomial and plan.fallback != "cvc5" and registry.is_installed("cvc5"):
             fallback = FallbackBackend(fallback, registry.load("cvc5"))
         backend = FallbackBackend(backend, fallback)
-    return RefutationFirst(backend) if polynomial and many else backend
+    atoms_first = not polynomial and len(plan.states) >= ATOMS_REFUTATION_FIRST
+    return RefutationFirst(backend) if (polynomial and many) or atoms_first else backend

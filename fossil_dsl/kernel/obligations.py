@@ -53,6 +53,9 @@ class Obligation:
     text: str
     query: L.Formula  # satisfiable exactly when the fact fails
     first: str = ""  # the procedure to try first (only the order changes, never a verdict)
+    # the query's closure holds at the origin (x != 0 near it): a procedure that reads
+    # strict comparisons as non-strict, as the interval procedure does, cannot prove it
+    closure_holds: bool = False
 
     @property
     def file_stem(self) -> str:
@@ -133,11 +136,12 @@ class Facts:
 
     # ---- obligations ----
     def never(self, name: str, text: str, region: L.Formula, failure: L.Formula,
-              first: str = "") -> None:
+              first: str = "", closure_holds: bool = False) -> None:
         """`failure` never happens in `region`; the expressions of `failure` are also
         obligated to be defined throughout `region`."""
         self.defined(name, region, _expressions(failure))
-        self.obligations.append(Obligation(name, text, L.conjunction(region, failure), first))
+        self.obligations.append(Obligation(name, text, L.conjunction(region, failure), first,
+                                           closure_holds))
 
     def lands_in(self, name: str, text: str, region: L.Formula, target: S.SetExpr) -> None:
         """Every x in `region` is mapped into `target` by one step of the closed loop."""

@@ -14,6 +14,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.kernel.local import negative_near_origin
 from fossil_dsl.kernel.obligations import BALL_ROOM, GAMMA, Claim, Facts, Obligation
+from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.kernel.registry import rule, strengthening
 
 CONTINUOUS, DISCRETE = TimeDomain.CONTINUOUS, TimeDomain.DISCRETE
@@ -96,6 +97,30 @@ def no_ball_left_out(facts: Facts) -> bool:
         and negative_near_origin(facts, "decrease", facts.change("V"), "the change of V")
 
 
+def ball_refuted(facts: Facts) -> bool:
+    """V > 0 and V decreasing on the excluded ball too (but at 0), as two obligations
+    on the punctured ball itself: a refutation of their polynomial form (kernel/prove.py)
+    proves them where the lemma's third-derivative bounds take minutes (6 states, sin)."""
+    if facts.r <= 0:
+        return False
+    punctured = L.conjunction(facts.ball(facts.r),
+                              L.Compare(">", facts.squared_norm(), E.ZERO))
+    words = f"0 < |x| <= {facts.r}"
+    change = "V(f(x)) - V(x)" if facts.discrete else "dV/dt"
+    facts.never("ball:positive", f"V(x) > 0 for {words}", punctured,
+                L.negation(compare(">", facts.value("V"))), SUM_OF_SQUARES, True)
+    facts.never("ball:decrease", f"{change} < 0 for {words}", punctured,
+                L.negation(compare("<", facts.change("V"))), SUM_OF_SQUARES, True)
+    return True
+
+
+def ball_strengthenings(form: str, guarantee) -> None:
+    """The ball round the origin proved directly, else by the Taylor lemma."""
+    for name, add in (("no ball left out, directly", ball_refuted),
+                      ("no ball left out", no_ball_left_out)):
+        strengthening(form, CONTINUOUS, name=name, guarantee=guarantee)(add)
+
+
 def lemma_radius(claim: Claim, halvings: int = 4) -> Fraction | None:
     """The largest of r, r/2, ..., r/2^halvings (r: the claim's excluded ball) at which
     the Taylor lemma's own choices of μ and M pass for V and its change, so that its
@@ -131,8 +156,7 @@ def stability(facts: Facts) -> None:
 
 
 # (in discrete time the rule itself uses the lemma where it applies: see neighbourhood)
-strengthening("stability", CONTINUOUS, name="no ball left out",
-              guarantee=stability_guarantee)(no_ball_left_out)
+ball_strengthenings("stability", stability_guarantee)
 
 
 def stable_sublevel_set(facts: Facts) -> None:
@@ -182,13 +206,11 @@ def largest_region_guarantee(discrete: bool) -> str:
 # `prove stable` with `region: largest`: the region is the result, there is no I
 rule("largest region of attraction", CONTINUOUS, DISCRETE,
      guarantee=largest_region_guarantee)(stable_sublevel_set)
-strengthening("largest region of attraction", CONTINUOUS, name="no ball left out",
-              guarantee=largest_region_guarantee)(no_ball_left_out)
+ball_strengthenings("largest region of attraction", largest_region_guarantee)
 
 
 rule("region of attraction", guarantee=ROA_GUARANTEE)(region_of_attraction)
-strengthening("region of attraction", CONTINUOUS, name="no ball left out",
-              guarantee=ROA_GUARANTEE)(no_ball_left_out)
+ball_strengthenings("region of attraction", ROA_GUARANTEE)
 
 
 def barrier_signs(facts: Facts, name: str, inside: L.Formula, outside: L.Formula,
@@ -220,8 +242,7 @@ SWA_GUARANTEE = ROA_GUARANTEE + ("; and those trajectories never enter U: B <= 0
                                  "B > 0 on U, and B strictly decreases wherever B = 0 in D")
 
 
-strengthening("stable while avoid", CONTINUOUS, name="no ball left out",
-              guarantee=SWA_GUARANTEE)(no_ball_left_out)
+ball_strengthenings("stable while avoid", SWA_GUARANTEE)
 
 
 @rule("stable while avoid", guarantee=SWA_GUARANTEE)

@@ -33,7 +33,7 @@ def _conjuncts(formula: L.Formula) -> list[L.Formula]:
     if isinstance(formula, L.And):
         return [atom for arg in formula.args for atom in _conjuncts(arg)]
     if isinstance(formula, L.Not) and isinstance(formula.arg, L.Compare):
-        return [L.negated_inward(formula)]
+        return [L.negated_inward(formula.arg)]  # the comparison, flipped
     return [formula]
 
 

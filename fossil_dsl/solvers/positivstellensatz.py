@@ -14,6 +14,10 @@ or a constant c > 0 is added to the sum (the strict comparison 1 > 0). At a poin
 the query held, every term would be >= 0 with sum 0, so every term 0; but c_k h_k^m > 0
 (or c > 0).
 So no point satisfies the query, and the obligation holds.
+
+A query with elementary functions (sin, exp, ...) is first made polynomial by
+atom_facts.py: a variable per function application, and facts each such value
+satisfies; a refutation of that polynomial query refutes the query.
 """
 from __future__ import annotations
 
@@ -24,6 +28,7 @@ from typing import Sequence
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.expr import add, neg
+from fossil_dsl.solvers.atom_facts import abstracted, has_atoms
 
 
 @dataclass(frozen=True)
@@ -100,9 +105,19 @@ def conjuncts(query: L.Formula) -> list[L.Formula]:
     return [query]
 
 
+def polynomial_form(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tuple]:
+    """The query and its variables; a query with elementary functions as the polynomial
+    query with a variable per function application and the facts every point of the
+    query satisfies (atom_facts.py): a refutation of that one refutes the query."""
+    if not has_atoms(query):
+        return query, tuple(states)
+    return abstracted(query, states)
+
+
 def refutation_problem(refutation: Refutation, query: L.Formula,
                        states: Sequence[str]) -> str | None:
     """None if the refutation proves the query unsatisfiable; else what is wrong."""
+    query, states = polynomial_form(query, states)
     try:
         atoms = comparisons(query, states)
     except ValueError as exc:  # NotPolynomial is a ValueError too

@@ -8,6 +8,8 @@ projection onto the Gram matrices that satisfy the identity: each entry feeds on
 monomial, so each monomial's residual is spread evenly over its entries). The result is
 checked exactly before it is returned: a refutation from here is a proof. `SosBackend`
 answers UNSAT with it, and UNKNOWN otherwise (never SAT: it finds no counterexamples).
+A query with elementary functions is refuted through its polynomial form
+(positivstellensatz.polynomial_form).
 """
 from __future__ import annotations
 
@@ -23,7 +25,8 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.solvers.api import Answer, Status
 from fossil_dsl.solvers.positivstellensatz import (Power, Refutation, SumOfSquares, comparisons,
-                                                  positive_semidefinite, refutation_problem)
+                                                  polynomial_form, positive_semidefinite,
+                                                  refutation_problem)
 from fossil_dsl.solvers.sdp import Program
 
 MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
@@ -44,6 +47,7 @@ class SosBackend:
 
 def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
     """A refutation of the query that checks exactly (see the module's text), or None."""
+    query, states = polynomial_form(query, states)
     try:
         atoms = comparisons(query, states)
     except ValueError:

@@ -1,0 +1,218 @@
+"""A polynomial query that every point of a transcendental query extends to.
+
+Each application f(a) of an elementary function in a query is replaced by a fresh
+variable t, and polynomial facts about t = f(a) are added as conjuncts. Every fact holds
+for every real argument (universal), or for every argument in a range that the query's
+own top-level conjuncts imply (from `c <= x`, `x <= c` and axis-parallel ellipsoids:
+arb_box.py, worked out exactly). So a point x satisfying the query gives the point
+(x, f(a(x)), ...) satisfying the polynomial query: if that one is unsatisfiable (a
+sum-of-squares refutation, checked exactly), so is the query.
+
+Universal facts (t = f(a)):
+- sin: sin a lies between a and a - a^3/6 (for a >= 0, a - a^3/6 <= sin a <= a by the
+  alternating Taylor series; sin is odd): (t - a)(t - a + a^3/6) <= 0; and t^2 <= 1.
+- cos: 1 - a^2/2 <= cos a <= 1 (the same argument; cos is even).
+- tanh, atan: between 0 and a, i.e. t (t - a) <= 0; between a and a - a^3/3: g(a) = f(a)
+  - a + a^3/3 has g(0) = 0 and g'(a) = a^2 - tanh(a)^2 >= 0 (tanh), a^4/(1 + a^2) >= 0
+  (atan), so g >= 0 for a >= 0 (both are odd); and t^2 <= 1 (tanh), t^2 <= 2.4675 >
+  (pi/2)^2 (atan).
+- exp: t > 0 and t >= 1 + a (convexity: the tangent at 0).
+Facts for |a| <= L, with the constants below rounded the safe way from arb's enclosures:
+- sin (L <= 3), tanh, atan: f(a)/a decreases in |a| from 1, so t lies between a and k a,
+  k = f(L)/L: (t - a)(t - k a) <= 0. (With these, the cubic facts are left out: they
+  only raise the degree of the refutation.)
+- cos (L <= 3): (1 - cos a)/a^2 decreases in |a|, so t <= 1 - c a^2, c = (1 - cos L)/L^2.
+- exp, for lo <= a <= hi: below the chord, t <= E(lo) + (a - lo)(E(hi) - E(lo))/(hi - lo)
+  with E an upper bound of exp (convexity).
+Other functions (log, sqrt, tan) become a variable with no fact; abs stays (solvers
+encode it). tests/test_atom_facts.py checks every fact at many points with arb.
+"""
+from __future__ import annotations
+
+from fractions import Fraction
+from math import ceil, floor
+from typing import Sequence
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir import traversal
+from fossil_dsl.solvers.arb_box import starting_box
+
+ATOM_PREFIX = "@"  # not a spec identifier's first character: no clash with a state
+GRID = 10 ** 9  # constants are rounded (the safe way) to this many parts of one
+SINE_RANGE = 3  # below pi: sin(a)/a and (1 - cos a)/a^2 still decrease
+
+
+def _n(value) -> E.Num:
+    return E.Num(Fraction(value))
+
+
+def _cube(a: E.Expr) -> E.Expr:
+    return E.power(a, _n(3))
+
+
+def _between(t: E.Expr, one: E.Expr, other: E.Expr) -> L.Formula:
+    """t lies between `one` and `other` (in either order): (t - one)(t - other) <= 0."""
+    product = E.mul(E.add(t, E.neg(one)), E.add(t, E.neg(other)))
+    return L.Compare("<=", product, _n(0))
+
+
+def _at_most(smaller: E.Expr, larger) -> L.Formula:
+    return L.Compare("<=", smaller, larger if isinstance(larger, E.Expr) else _n(larger))
+
+
+def _minus_cube(a: E.Expr, share: Fraction) -> E.Expr:
+    return E.add(a, E.neg(E.mul(_n(share), _cube(a))))
+
+
+def _facts(func: str, a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+    """reach: (lo, hi) with lo <= a <= hi wherever the query holds, or None."""
+    square = E.power(t, _n(2))
+    width = None if reach is None else max(-reach[0], reach[1])
+    if func == "sin":
+        facts = [_at_most(square, 1)]
+        if width is not None and 0 < width <= SINE_RANGE:
+            return facts + [_between(t, a, E.mul(_n(_lower(_sin_ratio(width))), a))]
+        return facts + [_between(t, a, _minus_cube(a, Fraction(1, 6)))]
+    if func == "cos":
+        half = E.add(_n(1), E.neg(E.mul(_n(Fraction(1, 2)), E.power(a, _n(2)))))
+        facts = [_at_most(half, t), _at_most(t, 1)]
+        if width is not None and 0 < width <= SINE_RANGE:
+            c = _lower(_cosine_ratio(width))
+            facts.append(_at_most(t, E.add(_n(1), E.neg(E.mul(_n(c), E.power(a, _n(2)))))))
+        return facts
+    if func in ("tanh", "atan"):
+        bound = 1 if func == "tanh" else Fraction("2.4675")
+        facts = [_at_most(square, bound), _between(t, _n(0), a)]
+        if width is not None and width > 0:
+            return facts + [_between(t, a, E.mul(_n(_lower(_ratio(func, width))), a))]
+        return facts + [_between(t, a, _minus_cube(a, Fraction(1, 3)))]
+    if func == "exp":
+        facts = [L.Compare(">", t, _n(0)), _at_most(E.add(_n(1), a), t)]
+        if reach is not None and reach[0] < reach[1]:
+            facts.append(_at_most(t, _chord(a, *reach)))
+        return facts
+    return []
+
+
+def _chord(a: E.Expr, lo: Fraction, hi: Fraction) -> E.Expr:
+    at_lo, at_hi = _upper(_arb(lo).exp()), _upper(_arb(hi).exp())
+    slope = (at_hi - at_lo) / (hi - lo)
+    return E.add(_n(at_lo), E.mul(_n(slope), E.add(a, _n(-lo))))
+
+
+def _arb(value: Fraction):
+    import flint
+    return flint.arb(value.numerator) / value.denominator
+
+
+def _sin_ratio(width: Fraction):
+    return _arb(width).sin() / _arb(width)
+
+
+def _cosine_ratio(width: Fraction):
+    return (1 - _arb(width).cos()) / _arb(width) ** 2
+
+
+def _ratio(func: str, width: Fraction):
+    return getattr(_arb(width), func)() / _arb(width)
+
+
+def _lower(value) -> Fraction:
+    mantissa, exponent = value.lower().mid().man_exp()
+    return Fraction(floor(Fraction(int(mantissa)) * Fraction(2) ** int(exponent) * GRID), GRID)
+
+
+def _upper(value) -> Fraction:
+    mantissa, exponent = value.upper().mid().man_exp()
+    return Fraction(ceil(Fraction(int(mantissa)) * Fraction(2) ** int(exponent) * GRID), GRID)
+
+
+def has_atoms(query: L.Formula) -> bool:
+    return any(isinstance(node, E.Apply) and node.func != "abs"
+               for c in L.comparisons(query) for side in (c.left, c.right)
+               for node in E.walk(side))
+
+
+def abstracted(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tuple[str, ...]]:
+    """The polynomial query (the module's text) and its variables: the states, then one
+    per distinct function application, named in the order they are first met."""
+    table = _Table()
+    body = _rewrite(query, table)
+    facts = [fact for (func, argument), name in table.names.items()
+             for fact in _facts(func, argument, E.Var(name), _reach(argument, query))]
+    return L.conjunction(body, *facts), tuple(states) + tuple(table.names.values())
+
+
+def _reach(argument: E.Expr, query: L.Formula) -> tuple[Fraction, Fraction] | None:
+    """Exact bounds of a polynomial argument over the box the query's conjuncts give
+    its variables, or None (an argument with a replaced function in it, or unbounded)."""
+    names = sorted(E.free_vars(argument))
+    if not names or any(name.startswith(ATOM_PREFIX) for name in names):
+        return None
+    box = _bounds(query, names)
+    if box is None:
+        return None
+    try:
+        polynomial = P.polynomial(argument, names)
+    except ValueError:
+        return None
+    low = high = Fraction(0)
+    for monomial, coefficient in polynomial.items():
+        lo, hi = _monomial_range(monomial, [(Fraction(a), Fraction(b)) for a, b in box])
+        ends = (coefficient * lo, coefficient * hi)
+        low, high = low + min(ends), high + max(ends)
+    return low, high
+
+
+def _bounds(query: L.Formula, names: list[str]):
+    """Bounds of the names from the query's conjuncts: those that bound all of the
+    query's variables at once (a ball in every state), else those on the names alone."""
+    everything = sorted(v for v in L.free_vars(query) if not v.startswith(ATOM_PREFIX))
+    box = starting_box(query, everything)
+    if box is not None:
+        return [box[everything.index(name)] for name in names]
+    return starting_box(query, names)
+
+
+def _monomial_range(monomial, box) -> tuple[Fraction, Fraction]:
+    low = high = Fraction(1)
+    for power, (lo, hi) in zip(monomial, box):
+        for _ in range(power):
+            ends = (low * lo, low * hi, high * lo, high * hi)
+            low, high = min(ends), max(ends)
+    return low, high
+
+
+class _Table:
+    def __init__(self):
+        self.names: dict[tuple[str, E.Expr], str] = {}
+
+    def variable(self, func: str, argument: E.Expr) -> E.Var:
+        key = (func, argument)
+        if key not in self.names:
+            self.names[key] = f"{ATOM_PREFIX}{func}{len(self.names)}"
+        return E.Var(self.names[key])
+
+
+def _rewrite(formula: L.Formula, table: _Table) -> L.Formula:
+    if isinstance(formula, L.Compare):
+        return L.Compare(formula.relation, _replaced(formula.left, table),
+                         _replaced(formula.right, table))
+    if isinstance(formula, L.And):
+        return L.conjunction(*[_rewrite(arg, table) for arg in formula.args])
+    if isinstance(formula, L.Or):
+        return L.disjunction(*[_rewrite(arg, table) for arg in formula.args])
+    if isinstance(formula, L.Not):
+        return L.negation(_rewrite(formula.arg, table))
+    return formula
+
+
+def _replaced(expr: E.Expr, table: _Table) -> E.Expr:
+    """Innermost applications first, so an argument is itself polynomial."""
+    if isinstance(expr, (E.Num, E.Var, E.Pi)):
+        return expr
+    if isinstance(expr, E.Apply) and expr.func != "abs":  # abs stays: solvers encode it
+        return table.variable(expr.func, _replaced(expr.arg, table))
+    return traversal.rebuild(expr, tuple(_replaced(c, table) for c in E.children(expr)))
