@@ -25,7 +25,7 @@ Facts for |a| <= L, with the constants below rounded the safe way from arb's enc
 - exp, for lo <= a <= hi: below the chord, t <= E(lo) + (a - lo)(E(hi) - E(lo))/(hi - lo)
   with E an upper bound of exp (convexity).
 Other functions (log, sqrt, tan) become a variable with no fact; abs stays (solvers
-encode it). tests/test_atom_facts.py checks every fact at many points with arb.
+encode it). tests/test_atom_facts.py checks every fact at many points against sympy at 60 digits.
 """
 from __future__ import annotations
 
@@ -58,42 +58,70 @@ def _between(t: E.Expr, one: E.Expr, other: E.Expr) -> L.Formula:
     return L.Compare("<=", product, _n(0))
 
 
-def _at_most(smaller: E.Expr, larger) -> L.Formula:
-    return L.Compare("<=", smaller, larger if isinstance(larger, E.Expr) else _n(larger))
+def _at_most(smaller: E.Expr, larger: E.Expr) -> L.Formula:
+    return L.Compare("<=", smaller, larger)
 
 
 def _minus_cube(a: E.Expr, share: Fraction) -> E.Expr:
     return E.add(a, E.neg(E.mul(_n(share), _cube(a))))
 
 
-def _facts(func: str, a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
-    """reach: (lo, hi) with lo <= a <= hi wherever the query holds, or None."""
-    square = E.power(t, _n(2))
+def _sin(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+    width = _width(reach)
+    if width is not None and width <= SINE_RANGE:
+        return [_square_at_most(t, 1), _between(t, a, _scaled(_sin_ratio(width), a))]
+    return [_square_at_most(t, 1), _between(t, a, _minus_cube(a, Fraction(1, 6)))]
+
+
+def _cos(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+    facts = [_at_most(_one_minus(Fraction(1, 2), a), t), _at_most(t, _n(1))]
+    width = _width(reach)
+    if width is not None and width <= SINE_RANGE:
+        facts.append(_at_most(t, _one_minus(_lower(_cosine_ratio(width)), a)))
+    return facts
+
+
+def _sigmoid(func: str, square_bound: Fraction):
+    """tanh and atan: the same facts, with their own ratio and bound."""
+    def facts(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+        width = _width(reach)
+        nearer = _minus_cube(a, Fraction(1, 3)) if width is None else \
+            _scaled(_ratio(func, width), a)
+        return [_square_at_most(t, square_bound), _between(t, _n(0), a),
+                _between(t, a, nearer)]
+    return facts
+
+
+def _exp(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+    facts = [L.Compare(">", t, _n(0)), _at_most(E.add(_n(1), a), t)]
+    if reach is not None and reach[0] < reach[1]:
+        facts.append(_at_most(t, _chord(a, *reach)))
+    return facts
+
+
+# t = f(a) -> its facts, given (lo, hi) with lo <= a <= hi wherever the query holds, or
+# None; a function not here becomes a variable with no fact
+FACTS = {"sin": _sin, "cos": _cos, "tanh": _sigmoid("tanh", Fraction(1)),
+         "atan": _sigmoid("atan", Fraction("2.4675")), "exp": _exp}
+
+
+def _width(reach) -> Fraction | None:
+    """max |a| over the range, or None where none is known (or it is only 0)."""
     width = None if reach is None else max(-reach[0], reach[1])
-    if func == "sin":
-        facts = [_at_most(square, 1)]
-        if width is not None and 0 < width <= SINE_RANGE:
-            return facts + [_between(t, a, E.mul(_n(_lower(_sin_ratio(width))), a))]
-        return facts + [_between(t, a, _minus_cube(a, Fraction(1, 6)))]
-    if func == "cos":
-        half = E.add(_n(1), E.neg(E.mul(_n(Fraction(1, 2)), E.power(a, _n(2)))))
-        facts = [_at_most(half, t), _at_most(t, 1)]
-        if width is not None and 0 < width <= SINE_RANGE:
-            c = _lower(_cosine_ratio(width))
-            facts.append(_at_most(t, E.add(_n(1), E.neg(E.mul(_n(c), E.power(a, _n(2)))))))
-        return facts
-    if func in ("tanh", "atan"):
-        bound = 1 if func == "tanh" else Fraction("2.4675")
-        facts = [_at_most(square, bound), _between(t, _n(0), a)]
-        if width is not None and width > 0:
-            return facts + [_between(t, a, E.mul(_n(_lower(_ratio(func, width))), a))]
-        return facts + [_between(t, a, _minus_cube(a, Fraction(1, 3)))]
-    if func == "exp":
-        facts = [L.Compare(">", t, _n(0)), _at_most(E.add(_n(1), a), t)]
-        if reach is not None and reach[0] < reach[1]:
-            facts.append(_at_most(t, _chord(a, *reach)))
-        return facts
-    return []
+    return width if width else None
+
+
+def _square_at_most(t: E.Expr, bound) -> L.Formula:
+    return _at_most(E.power(t, _n(2)), _n(bound))
+
+
+def _scaled(ratio, a: E.Expr) -> E.Expr:
+    """k a for a rational k just below the arb ratio."""
+    return E.mul(_n(_lower(ratio)), a)
+
+
+def _one_minus(share: Fraction, a: E.Expr) -> E.Expr:
+    return E.add(_n(1), E.neg(E.mul(_n(share), E.power(a, _n(2)))))
 
 
 def _chord(a: E.Expr, lo: Fraction, hi: Fraction) -> E.Expr:
@@ -141,7 +169,8 @@ def abstracted(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tupl
     table = _Table()
     body = _rewrite(query, table)
     facts = [fact for (func, argument), name in table.names.items()
-             for fact in _facts(func, argument, E.Var(name), _reach(argument, query))]
+             if func in FACTS
+             for fact in FACTS[func](argument, E.Var(name), _reach(argument, query))]
     return L.conjunction(body, *facts), tuple(states) + tuple(table.names.values())
 
 

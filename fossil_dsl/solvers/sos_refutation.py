@@ -24,12 +24,19 @@ import numpy as np
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.solvers.api import Answer, Status
+from fossil_dsl.solvers.atom_facts import has_atoms
 from fossil_dsl.solvers.positivstellensatz import (Power, Refutation, SumOfSquares, comparisons,
                                                   polynomial_form, positive_semidefinite,
                                                   refutation_problem)
 from fossil_dsl.solvers.sdp import Program
 
 MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
+# for a query with elementary functions (tried first in the loop, on every query, most
+# of which it cannot refute), small programs only: a 3-state map's invariance condition
+# with sin and cos gave programs of 22 000 variables at 80 s each, another's of 1000 to
+# 2600 variables 0.3 to 5.5 s each, none a refutation; the refutations found (4- and
+# 6-state Lyapunov conditions with sin and tanh) are programs of a few hundred
+ATOMS_MAX_VARIABLES = 1_000
 MULTIPLIER_DECIMALS = 12  # kept of a refutation's multipliers
 POWERS = (1, 2)  # a strict comparison h > 0 enters as c h, else c h^2 (quartic decreases)
 
@@ -47,25 +54,35 @@ class SosBackend:
 
 def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
     """A refutation of the query that checks exactly (see the module's text), or None."""
+    abstract = has_atoms(query)
     query, states = polynomial_form(query, states)
     try:
         atoms = comparisons(query, states)
     except ValueError:
         return None
-    for power, low in ((m, low) for m in POWERS for low in (1, 2, 0)):
-        if time.monotonic() > deadline:
+    powers, limit = ((1,), ATOMS_MAX_VARIABLES) if abstract else (POWERS, MAX_VARIABLES)
+    for power, low in ((m, low) for m in powers for low in (1, 2, 0)):
+        if time.monotonic() > deadline or _smallest_size(len(states), atoms, power) > limit:
             return None
         try:
             program = _RefutationProgram(len(states), atoms, low, power)
         except _Hopeless:
             continue
-        if program.count > MAX_VARIABLES:
+        if program.count > limit:
             return None
         x = program.solve({program.interior: -1.0}, deadline - time.monotonic())
         found = program.exact(x) if x is not None else None
         if found is not None and refutation_problem(found, query, states) is None:
             return found
     return None
+
+
+def _smallest_size(n: int, atoms, power: int) -> int:
+    """The entries of s0's Gram matrix alone (a lower bound on the program's size, known
+    before building it: building a program of 700 000 variables took 9 s)."""
+    top = max(2, max(P.degree(h) * (power if strict else 1) for h, strict in atoms))
+    size = math.comb(n + (top + 1) // 2, n)
+    return size * (size + 1) // 2
 
 
 class _RefutationProgram(Program):
