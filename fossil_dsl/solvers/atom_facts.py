@@ -157,10 +157,14 @@ def _upper(value) -> Fraction:
     return Fraction(ceil(Fraction(int(mantissa)) * Fraction(2) ** int(exponent) * GRID), GRID)
 
 
+def replaceable(node: E.Expr) -> bool:
+    """A function application that becomes a variable (abs stays: solvers encode it)."""
+    return isinstance(node, E.Apply) and node.func != "abs"
+
+
 def has_atoms(query: L.Formula) -> bool:
-    return any(isinstance(node, E.Apply) and node.func != "abs"
-               for c in L.comparisons(query) for side in (c.left, c.right)
-               for node in E.walk(side))
+    return any(replaceable(node) for c in L.comparisons(query)
+               for side in (c.left, c.right) for node in E.walk(side))
 
 
 def abstracted(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tuple[str, ...]]:
@@ -242,6 +246,6 @@ def _replaced(expr: E.Expr, table: _Table) -> E.Expr:
     """Innermost applications first, so an argument is itself polynomial."""
     if isinstance(expr, (E.Num, E.Var, E.Pi)):
         return expr
-    if isinstance(expr, E.Apply) and expr.func != "abs":  # abs stays: solvers encode it
+    if replaceable(expr):
         return table.variable(expr.func, _replaced(expr.arg, table))
     return traversal.rebuild(expr, tuple(_replaced(c, table) for c in E.children(expr)))

@@ -21,10 +21,12 @@ from typing import Sequence
 
 import numpy as np
 
+from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import traversal
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.solvers.api import Answer, Status
-from fossil_dsl.solvers.atom_facts import has_atoms
+from fossil_dsl.solvers.atom_facts import has_atoms, replaceable
 from fossil_dsl.solvers.positivstellensatz import (Power, Refutation, SumOfSquares, comparisons,
                                                   polynomial_form, positive_semidefinite,
                                                   refutation_problem)
@@ -55,6 +57,8 @@ class SosBackend:
 def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
     """A refutation of the query that checks exactly (see the module's text), or None."""
     abstract = has_atoms(query)
+    if abstract and _least_abstracted_size(query, states) > ATOMS_MAX_VARIABLES:
+        return None  # before abstracting and expanding: a tanh network's V has dozens
     query, states = polynomial_form(query, states)
     try:
         atoms = comparisons(query, states)
@@ -75,6 +79,17 @@ def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
         if found is not None and refutation_problem(found, query, states) is None:
             return found
     return None
+
+
+def _least_abstracted_size(query: L.Formula, states) -> int:
+    """_smallest_size for the query's polynomial form, estimated from its expressions as
+    they are (no expansion): a variable per distinct application, and the syntactic
+    degree bound with each application counted as degree 1."""
+    sides = [side for c in L.comparisons(query) for side in (c.left, c.right)]
+    replaced = {node for side in sides for node in E.walk(side) if replaceable(node)}
+    n = len(states) + len(replaced)
+    size = math.comb(n + (max(2, *map(traversal.degree, sides)) + 1) // 2, n)
+    return size * (size + 1) // 2
 
 
 def _smallest_size(n: int, atoms, power: int) -> int:
