@@ -48,10 +48,18 @@ def spec_text(text: str):
     return fossil_dsl.loads(text, "test.fsl")
 
 
+# the punctured ball round the origin, proved directly: the interval procedure reads the
+# query closed, and the closure holds at the origin; these are re-checked from their
+# exported refutations (tests/test_local_lemma.py)
+ONLY_REFUTED = {"ball:positive", "ball:decrease"}
+
+
 def recheck_from_text(result) -> None:
     """Every exported obligation, read back from its SMT-LIB text, is UNSAT for a fresh
     interval verifier, and CVC5 never finds it satisfiable."""
     for name, script in result.obligations.items():
+        if name.replace("-", ":") in ONLY_REFUTED:
+            continue
         read = read_script(script)
         if not L.free_vars(read.formula):  # a fact about numbers (f(0) = 0): no box
             assert Z3Backend().check_text(script, timeout=10).status is Status.UNSAT, name
@@ -62,13 +70,14 @@ def recheck_from_text(result) -> None:
 
 
 def test_damped_pendulum_certified_with_the_ball_proved_apart():
-    # the delta-decision verifier leaves out |x| <= 0.01; the kernel's Taylor lemma
-    # proves the inside, so the guarantee is asymptotic stability, not ε-stability
+    # the delta-decision verifier leaves out |x| <= 0.01; the kernel proves the inside
+    # (directly, or by the Taylor lemma), so the guarantee is asymptotic stability, not
+    # ε-stability
     result = fossil_dsl.synthesise(spec_text(PENDULUM), seed=0)
     assert result.certified, result.reason
     assert result.plan.verifier in ("interval", "dreal")
     assert result.plan.origin_radius == Fraction(1, 100)
-    assert result.kernel.strengthened == "no ball left out"
+    assert result.kernel.strengthened in ("no ball left out, directly", "no ball left out")
     assert "ε-stability" not in result.guarantee()
     assert any("delta-decision" in a for a in result.assumptions())
     recheck_from_text(result)

@@ -17,8 +17,8 @@
   tests) and to a sum-of-squares refutation of their polynomial form (a variable per
   function application, with facts its value satisfies: solvers/atom_facts.py), which
   goes first from ATOMS_REFUTATION_FIRST states on or where it proved the condition
-  during the run. Only the interval procedure's UNSAT is used; a box it cannot refute
-  is "not proved", never a proof.
+  during the run. Only UNSAT is used from either; a box the interval procedure cannot
+  refute is "not proved", never a proof.
 
 Whatever a procedure says other than UNSAT (a counterexample, delta-SAT, UNKNOWN, a
 timeout) leaves the obligation unproved.
