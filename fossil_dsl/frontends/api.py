@@ -92,7 +92,7 @@ def _backend(plan: Plan, pieces=None):
     from fossil_dsl.solvers.sos_refutation import RefutationFirst
 
     def load(name: str):
-        backend = registry.load(name, plan.options.delta)
+        backend = registry.load(name, plan.options.delta, search=True)
         return SplitBackend(backend, pieces) if pieces and name == "interval" else backend
     backend = load(plan.verifier)
     polynomial, many = plan.verifier == "z3", len(plan.states) >= BEFORE_Z3_FROM

@@ -34,8 +34,11 @@ WITNESS_SEARCH = 2000  # boxes searched for a better witness after a doubtful on
 class IntervalBackend:
     name = "interval"
 
-    def __init__(self, delta: float = DELTA):
+    def __init__(self, delta: float = DELTA, leads_only: bool = False):
         self.delta = delta
+        # leads_only: codac's own tanh, not outward-rounded but three times faster to
+        # search with; for the CEGIS loop, whose answers the kernel judges again
+        self.rigorous = not leads_only
         self._compiled: dict = {}  # (query, names) -> its contractor (check_within)
 
     def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
@@ -44,7 +47,7 @@ class IntervalBackend:
         deadline = time.monotonic() + timeout
         with upward_rounding() as codac:
             try:
-                contractor = _Compiler(codac, names).formula(formula)
+                contractor = _Compiler(codac, names, self.rigorous).formula(formula)
             except UnsupportedTheory as exc:
                 return Answer(Status.UNKNOWN, reason=str(exc))
             if contractor is None:  # the formula is TRUE: any point
@@ -64,8 +67,9 @@ class IntervalBackend:
             key = (query, tuple(names))
             try:
                 if key not in self._compiled:
-                    self._compiled = {key: _Compiler(codac, names).formula(query)}
-                inside = _Compiler(codac, names).formula(region)
+                    compiler = _Compiler(codac, names, self.rigorous)
+                    self._compiled = {key: compiler.formula(query)}
+                inside = _Compiler(codac, names, self.rigorous).formula(region)
             except UnsupportedTheory as exc:
                 return Answer(Status.UNKNOWN, reason=str(exc))
             parts = [c for c in (self._compiled[key], inside) if c is not None]
@@ -184,8 +188,9 @@ def _delta_sat(box, names, variables, delta) -> Answer:
 class _Compiler:
     """Neutral formulas and expressions to codac contractors and analytic expressions."""
 
-    def __init__(self, codac, names):
+    def __init__(self, codac, names, rigorous: bool = True):
         self.codac = codac
+        self.rigorous = rigorous
         self.vector = codac.VectorVar(len(names))
         self.index = {name: i for i, name in enumerate(names)}
         # equal subexpressions become one codac node: a network's neurons recur in its
@@ -261,7 +266,7 @@ class _Compiler:
         if isinstance(expr, E.Apply):
             if not hasattr(codac, expr.func):
                 raise UnsupportedTheory(f"the interval verifier has no `{expr.func}`")
-            return function(expr.func, self.expr(expr.arg))
+            return function(expr.func, self.expr(expr.arg), self.rigorous)
         raise UnsupportedTheory(f"cannot translate {expr!r}")
 
     def power(self, expr: E.Pow):

@@ -21,6 +21,7 @@ class BackendInfo:
     rank: int  # preference among backends for transcendental problems (lower first)
     delta_decision: bool = False  # UNSAT is sound, SAT means delta-SAT (closed relaxation)
     caveat: str = ""  # what a proof by this backend assumes beyond UNSAT
+    search_option: str = ""  # keyword for a faster mode whose answers are leads only
 
 
 BACKENDS: dict[str, BackendInfo] = {b.name: b for b in (
@@ -33,7 +34,7 @@ BACKENDS: dict[str, BackendInfo] = {b.name: b for b in (
                 "dReal's API reads each exact constant as the nearest double"),
     BackendInfo("interval", "fossil_dsl.solvers.interval_backend", "IntervalBackend", "codac",
                 True, "a delta-decision procedure on outward-rounded interval arithmetic", 2,
-                True),
+                True, search_option="leads_only"),
 )}
 
 
@@ -51,8 +52,10 @@ def is_installed(name: str) -> bool:
             and importlib.util.find_spec(info.module) is not None)
 
 
-def load(name: str, delta: float | None = None) -> Backend:
-    """The backend called `name`; `delta` sets a delta-decision verifier's precision."""
+def load(name: str, delta: float | None = None, search: bool = False) -> Backend:
+    """The backend called `name`; `delta` sets a delta-decision verifier's precision.
+    `search`: its answers only guide the CEGIS loop (the kernel proves afresh), so a
+    backend with a faster mode whose answers are leads, not proofs, may use it."""
     info = BACKENDS[name]
     if not is_installed(name):
         others = ", ".join(n for n in BACKENDS if n != name and is_installed(n))
@@ -61,4 +64,7 @@ def load(name: str, delta: float | None = None) -> Backend:
             f"package `{info.requires}`); available: {others}")
     module = importlib.import_module(info.module)
     backend = getattr(module, info.class_name)
-    return backend(delta=delta) if info.delta_decision and delta else backend()
+    options = {"delta": delta} if info.delta_decision and delta else {}
+    if search and info.search_option:
+        options[info.search_option] = True
+    return backend(**options)
