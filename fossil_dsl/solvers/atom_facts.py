@@ -172,41 +172,47 @@ def abstracted(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tupl
     per distinct function application, named in the order they are first met."""
     table = _Table()
     body = _rewrite(query, table)
+    ranges = _Ranges(query)
     facts = [fact for (func, argument), name in table.names.items()
              if func in FACTS
-             for fact in FACTS[func](argument, E.Var(name), _reach(argument, query))]
+             for fact in FACTS[func](argument, E.Var(name), ranges.of(argument))]
     return L.conjunction(body, *facts), tuple(states) + tuple(table.names.values())
 
 
-def _reach(argument: E.Expr, query: L.Formula) -> tuple[Fraction, Fraction] | None:
-    """Exact bounds of a polynomial argument over the box the query's conjuncts give
-    its variables, or None (an argument with a replaced function in it, or unbounded)."""
-    names = sorted(E.free_vars(argument))
-    if not names or any(name.startswith(ATOM_PREFIX) for name in names):
-        return None
-    box = _bounds(query, names)
-    if box is None:
-        return None
-    try:
-        polynomial = P.polynomial(argument, names)
-    except ValueError:
-        return None
-    low = high = Fraction(0)
-    for monomial, coefficient in polynomial.items():
-        lo, hi = _monomial_range(monomial, [(Fraction(a), Fraction(b)) for a, b in box])
-        ends = (coefficient * lo, coefficient * hi)
-        low, high = low + min(ends), high + max(ends)
-    return low, high
+class _Ranges:
+    """Exact bounds of polynomial arguments over the box the query's conjuncts give
+    their variables: the box that bounds all of the query's variables at once (a ball in
+    every state), found once, else one on the argument's variables alone."""
 
+    def __init__(self, query: L.Formula):
+        self.query = query
+        self.everything = sorted(v for v in L.free_vars(query)
+                                 if not v.startswith(ATOM_PREFIX))
+        self.whole = starting_box(query, self.everything)
 
-def _bounds(query: L.Formula, names: list[str]):
-    """Bounds of the names from the query's conjuncts: those that bound all of the
-    query's variables at once (a ball in every state), else those on the names alone."""
-    everything = sorted(v for v in L.free_vars(query) if not v.startswith(ATOM_PREFIX))
-    box = starting_box(query, everything)
-    if box is not None:
-        return [box[everything.index(name)] for name in names]
-    return starting_box(query, names)
+    def of(self, argument: E.Expr) -> tuple[Fraction, Fraction] | None:
+        """None for an argument with a replaced function in it, or an unbounded one."""
+        names = sorted(E.free_vars(argument))
+        if not names or any(name.startswith(ATOM_PREFIX) for name in names):
+            return None
+        box = self._box(names)
+        if box is None:
+            return None
+        try:
+            polynomial = P.polynomial(argument, names)
+        except ValueError:
+            return None
+        low = high = Fraction(0)
+        for monomial, coefficient in polynomial.items():
+            lo, hi = _monomial_range(monomial, [(Fraction(a), Fraction(b)) for a, b in box])
+            ends = (coefficient * lo, coefficient * hi)
+            low, high = low + min(ends), high + max(ends)
+        return low, high
+
+    def _box(self, names: list[str]):
+        if self.whole is not None:
+            return [self.whole[self.everything.index(name)] for name in names]
+        return starting_box(self.query, names)
 
 
 def _monomial_range(monomial, box) -> tuple[Fraction, Fraction]:

@@ -87,16 +87,19 @@ def _least_abstracted_size(query: L.Formula, states) -> int:
     degree bound with each application counted as degree 1."""
     sides = [side for c in L.comparisons(query) for side in (c.left, c.right)]
     replaced = {node for side in sides for node in E.walk(side) if replaceable(node)}
-    n = len(states) + len(replaced)
-    size = math.comb(n + (max(2, *map(traversal.degree, sides)) + 1) // 2, n)
-    return size * (size + 1) // 2
+    return _gram_entries(len(states) + len(replaced), max(map(traversal.degree, sides)))
 
 
 def _smallest_size(n: int, atoms, power: int) -> int:
     """The entries of s0's Gram matrix alone (a lower bound on the program's size, known
     before building it: building a program of 700 000 variables took 9 s)."""
-    top = max(2, max(P.degree(h) * (power if strict else 1) for h, strict in atoms))
-    size = math.comb(n + (top + 1) // 2, n)
+    return _gram_entries(n, max(P.degree(h) * (power if strict else 1) for h, strict in atoms))
+
+
+def _gram_entries(n: int, degree: int) -> int:
+    """The entries of a symmetric Gram matrix over the monomials of n variables up to
+    half of max(2, degree), rounded up."""
+    size = math.comb(n + (max(2, degree) + 1) // 2, n)
     return size * (size + 1) // 2
 
 
