@@ -119,7 +119,7 @@ def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:
     """A basis (exact, each scaled to largest weight 1) of the combinations of the
     candidates whose change along the system is identically 0 over the atoms."""
     import flint
-    changes = [_change(c, field, states, discrete) for c in candidates]
+    changes = [calculus.change(c, states, field, discrete) for c in candidates]
     try:
         polynomials = AtomTable(states).polynomials(changes)
     except P.NotPolynomial:  # (a power with a symbolic exponent inside an atom's argument)
@@ -138,10 +138,6 @@ def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:
     return found
 
 
-def _change(function: E.Expr, field, states, discrete: bool) -> E.Expr:
-    if discrete:
-        return E.add(calculus.compose(function, states, field), E.neg(function))
-    return calculus.lie_derivative(function, states, field)
 
 
 def _integer_row(row: list[Fraction]) -> list[int]:

@@ -11,6 +11,7 @@ is undefined somewhere (log, division) still has its own obligation.
 """
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from typing import Sequence
 
@@ -18,11 +19,13 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
+from fossil_dsl.ir.functions import FUNCTIONS
 
 _POLYNOMIAL_NODES = (E.Num, E.Var, E.Add, E.Mul, E.Neg)
 # larger sides are left to the procedures: expanding a network's derivative over its
 # atoms can take seconds, and a conserved quantity's derivative is small
 MAX_NODES = 500
+MAX_TERMS = 2_000  # of an expansion (bounded before expanding)
 
 
 class AtomTable:
@@ -41,10 +44,19 @@ class AtomTable:
         """Each expression as a polynomial in the states, the atoms (in order of first
         appearance) and the states' inverses."""
         replaced = [self._replace(e) for e in expressions]
-        names = self.states + [v.name for v in self.atoms.values()] + \
-            [v.name for v in self.inverses.values()]
+        names = self.names()
         pairs = [(self.states.index(s), names.index(v.name)) for s, v in self.inverses.items()]
         return [_cancelled(P.polynomial(e, names), pairs) for e in replaced]
+
+    def names(self) -> list[str]:
+        return self.states + [v.name for v in self.atoms.values()] + \
+            [v.name for v in self.inverses.values()]
+
+    def expression(self, polynomial: P.Polynomial) -> E.Expr:
+        """The polynomial as an expression in the states, with the atoms put back."""
+        back = {v.name: atom for atom, v in self.atoms.items()}
+        back.update({v.name: E.div(E.ONE, E.Var(state)) for state, v in self.inverses.items()})
+        return traversal.substitute(P.to_expr(polynomial, self.names()), back)
 
     def _replace(self, expr: E.Expr) -> E.Expr:
         if isinstance(expr, E.Div):
@@ -92,6 +104,28 @@ def over_atoms(expr: E.Expr, states: Sequence[str]) -> tuple[P.Polynomial, list[
     """(the polynomial in states + atoms, the atoms in the order of their variables)."""
     table = AtomTable(states)
     return table.polynomials([expr])[0], list(table.atoms)
+
+
+def expanded(expr: E.Expr, states: Sequence[str]) -> E.Expr | None:
+    """The expression expanded as a polynomial over its atoms, or None: where it is not
+    defined everywhere (an expansion can cancel x / x, and with it an obligation), or
+    where the expansion could have more than MAX_TERMS terms."""
+    nodes = set(E.walk(expr))
+    if not all(_defined_everywhere(node, states) for node in nodes):
+        return None
+    atoms = {node for node in nodes if isinstance(node, E.Apply)}
+    count = len(states) + len(atoms)
+    if math.comb(count + traversal.degree(expr), count) > MAX_TERMS:
+        return None
+    table = AtomTable(states)
+    return table.expression(table.polynomials([expr])[0])
+
+
+def _defined_everywhere(node: E.Expr, states) -> bool:
+    """A polynomial operation, a number or an application of a total function."""
+    if isinstance(node, E.Apply):
+        return FUNCTIONS[node.func].total
+    return not _is_atom(node, states) or isinstance(node, (E.Pi, E.Var))
 
 
 def folded(formula: L.Formula, states: Sequence[str]) -> L.Formula:

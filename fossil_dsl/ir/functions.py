@@ -23,6 +23,7 @@ class Function:
     name: str
     exact: Callable[[Fraction], Fraction | None]
     piecewise_linear: bool = False  # abs: expressible in linear arithmetic with ite
+    total: bool = True  # defined at every real number
 
 
 def _at_zero(value: int) -> Callable[[Fraction], Fraction | None]:
@@ -50,10 +51,10 @@ def _isqrt_exact(n: int) -> int | None:
 FUNCTIONS: Mapping[str, Function] = {f.name: f for f in (
     Function("sin", _at_zero(0)),
     Function("cos", _at_zero(1)),
-    Function("tan", _at_zero(0)),
+    Function("tan", _at_zero(0), total=False),
     Function("exp", _at_zero(1)),
-    Function("log", _exact_log),
-    Function("sqrt", _exact_sqrt),
+    Function("log", _exact_log, total=False),
+    Function("sqrt", _exact_sqrt, total=False),
     Function("tanh", _at_zero(0)),
     Function("atan", _at_zero(0)),
     Function("abs", abs, piecewise_linear=True),

@@ -113,10 +113,7 @@ class Facts:
 
     def change(self, name: str) -> E.Expr:
         """dC/dt along the closed loop, or C(f(x)) - C(x) in discrete time."""
-        value = self.value(name)
-        if self.discrete:
-            return E.add(calculus.compose(value, self.states, self.field), E.neg(value))
-        return calculus.lie_derivative(value, self.states, self.field)
+        return calculus.change(self.value(name), self.states, self.field, self.discrete)
 
     def level(self, name: str) -> E.Num:
         if name not in self.claim.levels:
