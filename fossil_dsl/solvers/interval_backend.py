@@ -193,9 +193,11 @@ class _Compiler:
         self.rigorous = rigorous
         self.vector = codac.VectorVar(len(names))
         self.index = {name: i for i, name in enumerate(names)}
-        # equal subexpressions become one codac node: a network's neurons recur in its
-        # derivative, and codac then evaluates them once per box and intersects what
-        # each occurrence says about them when contracting
+        # equal subexpressions become one codac node object: a network's neurons recur
+        # in its derivative. codac (2.1.2) still evaluates the expression as a tree, once
+        # per occurrence (an expression of depth 14 with each level used twice: 66 ms
+        # per evaluation, 0.8 ms at depth 8): f1_barr3's flow query is 754 distinct
+        # nodes but a 12 600-node tree, 10 ms per contraction
         self.shared: dict[E.Expr, object] = {}
 
     def formula(self, formula: L.Formula):
