@@ -313,12 +313,10 @@ def test_every_enclosure_contains_the_true_value(name):
 
 
 def _double_enclosure(value) -> tuple[float, float]:
-    """The narrowest pair of doubles around an mpmath number."""
-    import math
-    near = float(value)
-    low = near if mpmath.mpf(near) <= value else math.nextafter(near, -math.inf)
-    high = near if mpmath.mpf(near) >= value else math.nextafter(near, math.inf)
-    return low, high
+    """The narrowest pair of doubles around an mpmath number (exactly a binary fraction)."""
+    from fossil_dsl.ir.enclosure import rational_bounds
+    sign = int(mpmath.sign(value))  # (mpmath's mantissa is unsigned)
+    return rational_bounds(sign * Fraction(int(value.man)) * Fraction(2) ** int(value.exp))
 
 
 @pytest.mark.parametrize("name", sorted(FUNCTIONS))

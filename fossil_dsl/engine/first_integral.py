@@ -138,8 +138,6 @@ def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:
     return found
 
 
-
-
 def _integer_row(row: list[Fraction]) -> list[int]:
     scale = int(np.lcm.reduce([v.denominator for v in row])) if row else 1
     return [int(v * scale) for v in row]
