@@ -44,7 +44,7 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
     started = time.monotonic()
     backend = None if plan.options.learn_only else _backend(plan, pieces)
     plan, outcome = run_attempts(plan, backend, progress)
-    verdict = _judge(plan, outcome, pieces)
+    verdict = _judge(plan, outcome, pieces, deadline=started + plan.options.timeout)
     found = None
     if plan.options.largest_region and verdict.certified:
         outcome, verdict, found = _largest(plan, outcome, verdict, pieces, started)
@@ -69,13 +69,21 @@ def _largest(plan: Plan, outcome, verdict: Verdict, pieces, started: float):
     return replace(outcome, candidate=candidate), found.verdict, found
 
 
-def _judge(plan: Plan, outcome, pieces=None) -> Verdict:
+def _judge(plan: Plan, outcome, pieces=None, deadline: float | None = None) -> Verdict:
     """The kernel's verdict on the engine's final formulas (judged afresh from the spec
-    and those formulas alone; the engine's own answers are not used)."""
+    and those formulas alone; the engine's own answers are not used), within what is
+    left of the run's timeout: the language's `timeout` is for the whole run (f1_barr3
+    certified in 122 s of a 120 s run when the judgement had a bound per obligation
+    only)."""
     if not outcome.certified:
         return not_certified(outcome.reason)
-    return judge(claim_of(plan, outcome), timeout=plan.options.query_timeout,
-                 delta=plan.options.delta, pieces=pieces)
+    verdict = judge(claim_of(plan, outcome), timeout=plan.options.query_timeout,
+                    delta=plan.options.delta, pieces=pieces, deadline=deadline)
+    if not verdict.certified and deadline is not None and time.monotonic() >= deadline:
+        return replace(verdict, reason=f"the run's timeout ({plan.options.timeout:g} s) "
+                       f"passed while the kernel judged the final candidate: "
+                       f"{verdict.reason}")
+    return verdict
 
 
 def _backend(plan: Plan, pieces=None):

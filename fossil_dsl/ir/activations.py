@@ -13,6 +13,13 @@ from typing import Callable
 from fossil_dsl.ir import expr as E
 
 
+# sigmoid(z) = 1/2 + tanh(z/2)/2, the same function as 1/(1 + exp(-z)) but with a
+# derivative, 1/4 (1 - tanh(z/2)^2), that holds z once where the quotient's holds it
+# twice: a two-layer network's flow query is a tree half the size, and its enclosures
+# are tighter (f1_barr3's flow proof: 2628 -> 1284 contractions)
+HALF = E.Num(Fraction(1, 2))
+
+
 def _chunk_power(index: int, width: int, degree: int) -> int:
     """polyN splits a layer's neurons into N chunks with powers 1..N."""
     return 1 + (index * degree) // width
@@ -59,7 +66,7 @@ ACTIVATIONS: dict[str, Activation] = {a.name: a for a in (
                lambda z, i, w: E.mul(E.Num(Fraction(1, 2)), E.add(z, E.apply("abs", z))),
                lambda t: t.relu()),
     Activation("sigmoid", None, False,
-               lambda z, i, w: E.div(E.ONE, E.add(E.ONE, E.apply("exp", E.neg(z)))),
+               lambda z, i, w: E.add(HALF, E.mul(HALF, E.apply("tanh", E.mul(HALF, z)))),
                lambda t: t.sigmoid()),
     Activation("tanh", None, True, lambda z, i, w: E.apply("tanh", z), lambda t: t.tanh()),
     Activation("softplus", None, False,

@@ -81,3 +81,34 @@ def is_arithmetic(expr: Expr) -> bool:
 def _natural_exponent(exponent: Expr) -> bool:
     return isinstance(exponent, Num) and exponent.value.denominator == 1 \
         and exponent.value >= 0
+
+
+def distinct_nodes(expr: Expr):
+    """Every distinct subexpression once (a shared one is not visited again)."""
+    seen, stack = set(), [expr]
+    while stack:
+        node = stack.pop()
+        if node not in seen:
+            seen.add(node)
+            yield node
+            stack.extend(children(node))
+
+
+def has_function(expr: Expr) -> bool:
+    return any(isinstance(node, Apply) for node in distinct_nodes(expr))
+
+
+def tree_size(expr: Expr) -> int:
+    """How many nodes the expression has written out as a tree (a subexpression counts
+    once per occurrence): what an evaluator without shared results works through."""
+    sizes: dict[Expr, int] = {}
+    stack = [expr]
+    while stack:  # children before parents
+        node = stack[-1]
+        waiting = [child for child in children(node) if child not in sizes]
+        if waiting:
+            stack.extend(waiting)
+            continue
+        stack.pop()
+        sizes[node] = 1 + sum(sizes[child] for child in children(node))
+    return sizes[expr]
