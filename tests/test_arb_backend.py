@@ -132,3 +132,20 @@ def test_a_negated_conjunct_bounds_nothing():
     query = [*box(-1, 1, x, y), outside]
     assert starting_box(L.conjunction(*query), ["x", "y"]) == [(-1.0, 1.0), (-1.0, 1.0)]
     assert check(*query, L.Compare(">=", x, num(Fraction(1, 2)))) is not Status.UNSAT
+
+
+def test_a_union_bounds_its_variables_by_the_hull_of_its_parts():
+    """f1_barr3's initial set is a disc or two boxes: recheck's Arb procedure had no
+    starting box for its initial condition and left it UNKNOWN."""
+    disc = L.Compare("<=", E.add(E.power(E.add(x, num(Fraction(-3, 2))), num(2)),
+                                 E.power(y, num(2))), num(Fraction(1, 4)))
+    strip = L.conjunction(*box(Fraction(-9, 5), Fraction(-6, 5), x),
+                          *box(Fraction(-1, 10), Fraction(1, 10), y))
+    union = L.disjunction(disc, strip)
+    (xl, xh), (yl, yh) = starting_box(union, ["x", "y"])
+    assert xl <= -1.8 and 2 <= xh and yl <= -0.5 and 0.5 <= yh
+    assert xh - xl < 3.9 and yh - yl < 1.1
+    assert check(union, L.Compare(">=", E.apply("sin", y), num(Fraction(1, 2)))) \
+        is Status.UNSAT
+    # points of the strip have x <= -1.5: not refuted
+    assert check(union, L.Compare("<=", x, num(Fraction(-3, 2)))) is not Status.UNSAT

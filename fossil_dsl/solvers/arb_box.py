@@ -1,8 +1,9 @@
 """The starting box of the Arb refutation procedure (arb_backend.py): bounds that the
 query's own top-level conjuncts give each variable, worked out in exact rationals and
 rounded outwards: `c <= x`, `x <= c`, and axis-parallel ellipsoids
-`sum a_i (x_i - c_i)^2 <= r` (balls among them). A variable no conjunct bounds gets
-none (the search then answers UNKNOWN)."""
+`sum a_i (x_i - c_i)^2 <= r` (balls among them), and for a disjunction the hull of its
+disjuncts' boxes. A variable no conjunct bounds gets none (the search then answers
+UNKNOWN)."""
 from __future__ import annotations
 
 import math
@@ -16,17 +17,30 @@ BELOW, ABOVE = ("<", "<="), (">", ">=")
 
 
 def starting_box(formula: L.Formula, names) -> list[tuple[float, float]] | None:
-    """Float bounds (rounded outwards) for each variable from the query's top-level
-    conjuncts, or None where some variable gets none."""
-    low = {name: -math.inf for name in names}
-    high = {name: math.inf for name in names}
-    for atom in _conjuncts(formula):
-        for name, lower, upper in _bounds(atom, names):
-            low[name] = max(low[name], lower)
-            high[name] = min(high[name], upper)
+    """Float bounds (rounded outwards) for each variable from the query's conjuncts, a
+    disjunction's being the hull of its disjuncts' (a set given as a union of a disc and
+    boxes), or None where some variable gets none."""
+    low, high = _box(formula, names)
     if not all(math.isfinite(low[n]) and math.isfinite(high[n]) for n in names):
         return None
     return [(low[n], high[n]) for n in names]
+
+
+def _box(formula: L.Formula, names) -> tuple[dict, dict]:
+    """(low, high) per variable that every point of the formula's set lies within."""
+    low = {name: -math.inf for name in names}
+    high = {name: math.inf for name in names}
+    for atom in _conjuncts(formula):
+        if isinstance(atom, L.Or):
+            boxes = [_box(arg, names) for arg in atom.args]
+            bounds = [(name, min(b[0][name] for b in boxes), max(b[1][name] for b in boxes))
+                      for name in names]
+        else:
+            bounds = _bounds(atom, names)
+        for name, lower, upper in bounds:
+            low[name] = max(low[name], lower)
+            high[name] = min(high[name], upper)
+    return low, high
 
 
 def _conjuncts(formula: L.Formula) -> list[L.Formula]:
@@ -34,6 +48,8 @@ def _conjuncts(formula: L.Formula) -> list[L.Formula]:
         return [atom for arg in formula.args for atom in _conjuncts(arg)]
     if isinstance(formula, L.Not) and isinstance(formula.arg, L.Compare):
         return [L.negated_inward(formula.arg)]  # the comparison, flipped
+    if isinstance(formula, L.Not):
+        return _conjuncts(L.negated_inward(formula.arg))
     return [formula]
 
 
