@@ -107,3 +107,26 @@ def test_climb_moves_along_a_level_set_to_the_worst_point_in_the_box():
     free = climb(starts, lambda x: (-x.pow(2).sum(1), None), ([-2.0, -2.0], [2.0, 2.0]),
                  steps=30, step_fraction=0.02)
     assert free.abs().max() < 0.1  # no level set: plain ascent, to the origin here
+
+
+@pytest.mark.parametrize("activation", list(ACTIVATIONS))
+def test_formula_text_reads_back_as_the_same_expression(activation):
+    """recheck derives the obligations again from the formulas' text in result.json and
+    compares them with the exported ones: c*1/(u) used to read back as (c*1)/u, and
+    every sigmoid certificate was reported altered."""
+    from fossil_dsl.outputs.recheck import read_formulas
+    torch.manual_seed(7)
+    for zero_at_origin in (True, False):
+        network = Network(3, (Layer(activation, 4), Layer("square", 3)), zero_at_origin)
+        network.round_weights(3)
+        formula = network.formula(STATES, digits=3)
+        assert read_formulas({"V": E.to_text(formula)}, STATES)["V"] == formula
+
+
+def test_a_quotient_after_a_factor_reads_back_as_the_same_expression():
+    from fossil_dsl.outputs.recheck import read_formulas
+    x0 = E.Var("x0")
+    quotient = E.div(E.ONE, E.add(E.ONE, E.apply("exp", E.neg(x0))))
+    product = E.mul(E.Num(Fraction(263, 1000)), quotient)
+    assert E.to_text(product) == "0.263*(1/(exp(-x0) + 1))"
+    assert read_formulas({"V": E.to_text(product)}, STATES)["V"] == product

@@ -307,10 +307,19 @@ def _text(expr: Expr) -> tuple[str, int]:
     if isinstance(expr, Div):
         return f"{_wrap(expr.numerator, _PRODUCT)}/{_wrap(expr.denominator, _POWER)}", _PRODUCT
     if isinstance(expr, Mul):
-        return "*".join(_wrap(f, _PRODUCT) for f in expr.factors), _PRODUCT
+        return "*".join([_wrap(expr.factors[0], _PRODUCT)]
+                        + [_later_factor(f) for f in expr.factors[1:]]), _PRODUCT
     if isinstance(expr, Add):
         return _sum_text(expr.terms), _SUM
     raise TypeError(f"not an expression: {expr!r}")
+
+
+def _later_factor(factor: Expr) -> str:
+    """A factor after the first, in parentheses where it has a `/` of its own: c*1/u
+    reads back as (c*1)/u, another tree (recheck compared the obligations derived from
+    it with those exported and called every sigmoid certificate's "altered")."""
+    text, own = _text(factor)
+    return f"({text})" if own < _UNARY or "/" in text and own < _POWER else text
 
 
 def _sum_text(terms) -> str:
