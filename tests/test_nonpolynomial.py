@@ -342,3 +342,30 @@ def test_interval_compiler_shares_equal_subexpressions():
         compiler = _Compiler(codac, ["x0", "x1"])
         assert compiler.expr(neuron()) is compiler.expr(neuron())
         assert compiler.expr(E.mul(neuron(), x)) is not compiler.expr(neuron())
+
+
+class Deaf:
+    """A solver that heeds neither its time limit nor a stop (as a Z3 check that does not
+    respond to its interrupt)."""
+    def __init__(self, name, seconds):
+        self.name, self.seconds = name, seconds
+
+    def check(self, formula, variables, timeout, stop=None):
+        import time
+        from fossil_dsl.solvers.api import Answer
+        time.sleep(self.seconds)
+        return Answer(Status.UNSAT)
+
+
+def test_a_leader_that_does_not_stop_is_left_behind_at_its_time_limit(monkeypatch):
+    import time
+    from fossil_dsl.solvers import fallback
+    from fossil_dsl.solvers.api import Answer
+    monkeypatch.setattr(fallback, "ABANDON_AFTER", 0.3)
+    deaf = Deaf("z3", seconds=20)
+    unsure = Scripted("interval", Answer(Status.UNKNOWN, reason="timeout"))
+    started = time.monotonic()
+    answer = fallback.FallbackBackend(deaf, unsure).check(L.TRUE, ["x0"], 1.0)
+    assert time.monotonic() - started < 3  # not the 20 s the leader takes
+    assert answer.status is Status.UNKNOWN
+    assert "z3 had not stopped 0.3 s past its time limit" in answer.reason

@@ -1,6 +1,8 @@
 """The Python interface; the `fossilc` command is a thin layer over these functions."""
 from __future__ import annotations
 
+import importlib
+import importlib.util
 import time
 from dataclasses import replace
 
@@ -38,9 +40,7 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
     queries, in the loop and in the kernel, into pieces checked in parallel."""
     options = check_options(options)  # a bad value raises OptionError before any work
     plan = compile_spec(spec, certificate=certificate, **options)
-    if not verifier_only(plan):
-        from fossil_dsl.engine.learner import import_optimiser_support
-        import_optimiser_support()
+    _import_run_libraries(plan)
     started = time.monotonic()
     backend = None if plan.options.learn_only else _backend(plan, pieces)
     plan, outcome = run_attempts(plan, backend, progress)
@@ -50,6 +50,22 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
         outcome, verdict, found = _largest(plan, outcome, verdict, pieces, started)
     result = build_result(plan, outcome, verdict, time.monotonic() - started)
     return replace(result, region=region_report(result, found)) if found else result
+
+
+# Libraries a run's strategies and verifiers import on first use (the linearisation's
+# Lyapunov and Riccati solvers, the sum-of-squares programs, the solvers). Imported
+# before a run's clock starts, so that a run's time is its own work: 0.2-0.4 s of
+# imports had been most of a sub-second run's time (docs/benchmarks.md, session 41).
+RUN_LIBRARIES = ("scipy.linalg", "scipy.sparse", "clarabel", "codac", "cvc5", "z3")
+
+
+def _import_run_libraries(plan: Plan) -> None:
+    if not verifier_only(plan):
+        from fossil_dsl.engine.learner import import_optimiser_support
+        import_optimiser_support()
+    for name in RUN_LIBRARIES:
+        if importlib.util.find_spec(name.partition(".")[0]) is not None:
+            importlib.import_module(name)
 
 
 def _largest(plan: Plan, outcome, verdict: Verdict, pieces, started: float):

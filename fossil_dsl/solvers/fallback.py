@@ -25,6 +25,10 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.solvers.api import Answer, Backend, Status
 
 HEAD_START = 0.5  # s the leading solver runs alone before the other joins it
+# s past the race's time limit after which a leader that has not returned is left behind
+# (its thread is a daemon): a Z3 check that does not heed its interrupt must not hold
+# the run past its own timeout
+ABANDON_AFTER = 5.0
 
 
 class FallbackBackend:
@@ -68,11 +72,15 @@ def _race(leader: Backend, follower: Backend, formula, variables, timeout: float
         answers["follower"] = _ask(follower, formula, variables, left, finished)
         if answers["follower"].status is not Status.UNKNOWN:
             finished.set()
-    thread.join()
+    thread.join(max(0.0, started + timeout + ABANDON_AFTER - time.monotonic()))
     finished.set()  # ends the relay
     if relay is not None:
         relay.join()
-    return _outcome(leader, follower, answers)
+    answered = dict(answers)  # a leader left behind may still write its answer
+    if "leader" not in answered:
+        answered["leader"] = Answer(Status.UNKNOWN, reason=f"{leader.name} had not stopped "
+                                    f"{ABANDON_AFTER:g} s past its time limit; left behind")
+    return _outcome(leader, follower, answered)
 
 
 def _relay(stop: threading.Event, finished: threading.Event) -> threading.Thread:

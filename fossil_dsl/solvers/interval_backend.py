@@ -25,6 +25,7 @@ from typing import Sequence
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import function, rational_interval, upward_rounding
+from fossil_dsl.ir.sharing import worth_naming
 from fossil_dsl.solvers.api import Answer, Status, UnsupportedTheory
 
 DELTA = 1e-4  # the width under which a surviving box counts as a (delta-)solution
@@ -47,12 +48,13 @@ class IntervalBackend:
         deadline = time.monotonic() + timeout
         with upward_rounding() as codac:
             try:
-                contractor = _Compiler(codac, names, self.rigorous).formula(formula)
+                compiler = _Compiler(codac, names, self.rigorous, _named_terms(formula))
+                contractor = compiler.defined(compiler.formula(formula))
             except UnsupportedTheory as exc:
                 return Answer(Status.UNKNOWN, reason=str(exc))
             if contractor is None:  # the formula is TRUE: any point
                 return _unbounded() if names else Answer(Status.SAT, {})
-            start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
+            start = codac.IntervalVector([[-codac.oo, codac.oo]] * compiler.dimension)
             split = _worth_splitting(formula, names)
             return self._search(contractor, start, names, split, variables, deadline, stop)
 
@@ -67,16 +69,18 @@ class IntervalBackend:
             key = (query, tuple(names))
             try:
                 if key not in self._compiled:
-                    compiler = _Compiler(codac, names, self.rigorous)
-                    self._compiled = {key: compiler.formula(query)}
-                inside = _Compiler(codac, names, self.rigorous).formula(region)
+                    compiler = _Compiler(codac, names, self.rigorous, _named_terms(query))
+                    self._compiled = {key: (compiler.defined(compiler.formula(query)),
+                                            compiler.named)}
+                compiled, named = self._compiled[key]
+                inside = _Compiler(codac, names, self.rigorous, named).formula(region)
             except UnsupportedTheory as exc:
                 return Answer(Status.UNKNOWN, reason=str(exc))
-            parts = [c for c in (self._compiled[key], inside) if c is not None]
+            parts = [c for c in (compiled, inside) if c is not None]
             if not parts:
                 return _unbounded()
             contractor = _combine(parts, lambda a, b: a & b)
-            start = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
+            start = codac.IntervalVector([[-codac.oo, codac.oo]] * (len(names) + len(named)))
             split = _worth_splitting(L.conjunction(query, region), names)
             return self._search(contractor, start, names, split, variables, deadline, stop)
 
@@ -84,7 +88,7 @@ class IntervalBackend:
         contractor.contract(start)
         if start.is_empty():
             return Answer(Status.UNSAT)
-        if start.is_unbounded():
+        if any(start[i].is_unbounded() for i in range(len(names))):
             return _unbounded()
         stack, boxes, unresolved, since = [start], 0, None, 0
         while stack:
@@ -99,9 +103,9 @@ class IntervalBackend:
             if box.is_empty():
                 continue
             if max(box[i].diam() for i in split) < self.delta:
-                if _contract_to_fixpoint(contractor, box):
+                if _contract_to_fixpoint(contractor, box, len(names)):
                     continue
-                if _middle_may_satisfy(contractor, box):
+                if _middle_may_satisfy(contractor, box, len(names)):
                     return _delta_sat(box, names, variables, self.delta)
                 # its middle is refuted: look on for a better witness, keep this one
                 unresolved = unresolved or box
@@ -130,17 +134,19 @@ def hull(formula: L.Formula, names: Sequence[str]) -> list[tuple[float, float]] 
         if contractor is None:
             return None
         box = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
-        _contract_to_fixpoint(contractor, box, passes=5)
+        _contract_to_fixpoint(contractor, box, len(names), passes=5)
         if box.is_empty() or box.is_unbounded():
             return None
         return [(box[i].lb(), box[i].ub()) for i in range(len(names))]
 
 
-def _middle_may_satisfy(contractor, box) -> bool:
-    """Whether the box's middle point survives contraction: a witness the learner can
-    use, rather than a box that only interval overestimation keeps alive."""
+def _middle_may_satisfy(contractor, box, dimension: int) -> bool:
+    """Whether the box's middle point (in its first `dimension` directions, the query's
+    variables; named terms keep their intervals) survives contraction: a witness the
+    learner can use, rather than a box that only interval overestimation keeps alive."""
     middle = box.mid()
-    point = type(box)([[middle[i], middle[i]] for i in range(box.size())])
+    point = type(box)([[middle[i], middle[i]] if i < dimension else [box[i].lb(), box[i].ub()]
+                       for i in range(box.size())])
     contractor.contract(point)
     return not point.is_empty()
 
@@ -159,17 +165,24 @@ def _worth_splitting(formula: L.Formula, names) -> list[int]:
     return indices or list(range(len(names)))
 
 
-def _contract_to_fixpoint(contractor, box, passes: int = 50) -> bool:
-    """Contract until the box stops shrinking (one forward-backward pass is not
-    idempotent); True if it becomes empty."""
+def _contract_to_fixpoint(contractor, box, dimension: int, passes: int = 50) -> bool:
+    """Contract until the box stops shrinking in its first `dimension` directions (one
+    forward-backward pass is not idempotent); True if it becomes empty."""
+    def width():
+        return max((box[i].diam() for i in range(dimension)), default=0.0)
     for _ in range(passes):
-        before = box.max_diam()
+        before = width()
         contractor.contract(box)
         if box.is_empty():
             return True
-        if box.max_diam() > 0.99 * before:
+        if width() > 0.99 * before:
             return False
     return False
+
+
+def _named_terms(formula: L.Formula) -> tuple[E.Expr, ...]:
+    sides = [side for c in L.comparisons(formula) for side in (c.left, c.right)]
+    return tuple(worth_naming(sides))
 
 
 def _unbounded() -> Answer:
@@ -188,23 +201,40 @@ def _delta_sat(box, names, variables, delta) -> Answer:
 class _Compiler:
     """Neutral formulas and expressions to codac contractors and analytic expressions."""
 
-    def __init__(self, codac, names, rigorous: bool = True):
+    def __init__(self, codac, names, rigorous: bool = True, named: Sequence[E.Expr] = ()):
         self.codac = codac
         self.rigorous = rigorous
-        self.vector = codac.VectorVar(len(names))
+        self.dimension = len(names) + len(named)
+        self.vector = codac.VectorVar(self.dimension)
         self.index = {name: i for i, name in enumerate(names)}
+        # a named term is one more variable of the box, its value fixed by its
+        # definition (ir/sharing.py): the tree then holds one copy of it
+        self.named = tuple(named)
+        self.variable_of = {term: self.vector[len(names) + i] for i, term in enumerate(named)}
         # equal subexpressions become one codac node object: a network's neurons recur
         # in its derivative. codac (2.1.2) still evaluates the expression as a tree, once
         # per occurrence (an expression of depth 14 with each level used twice: 66 ms
         # per evaluation, 0.8 ms at depth 8): f1_barr3's flow query is 754 distinct
         # nodes but a 12 600-node tree, 10 ms per contraction
-        self.shared: dict[E.Expr, object] = {}
+        self.shared: dict[E.Expr, object] = dict(self.variable_of)
+
+    def defined(self, contractor):
+        """The contractor with the named terms' definitions, on both sides: first they
+        get their values from the variables, last the query's contraction of them is
+        passed back to the variables."""
+        if contractor is None or not self.named:
+            return contractor
+        codac = self.codac
+        definitions = [codac.CtcInverse_Interval(
+            codac.AnalyticFunction([self.vector], self.variable_of[term] - self._translate(term)),
+            codac.Interval(0, 0)) for term in self.named]  # inner terms first
+        return _combine(definitions + [contractor] + definitions[::-1], lambda a, b: a & b)
 
     def formula(self, formula: L.Formula):
         """A contractor for the closure of the formula's set; None for TRUE."""
         codac = self.codac
         if isinstance(formula, L.BoolConst):
-            return None if formula.value else codac.CtcEmpty(len(self.index))
+            return None if formula.value else codac.CtcEmpty(self.dimension)
         if isinstance(formula, L.Not):
             return self.formula(L.negated_inward(formula.arg))
         if isinstance(formula, L.Compare):
@@ -233,7 +263,7 @@ class _Compiler:
         value = self.expr(difference)
         below = relation in ("<", "<=")
         false = value.lb() > 0 if below else value.ub() < 0
-        return self.codac.CtcEmpty(len(self.index)) if false else None
+        return self.codac.CtcEmpty(self.dimension) if false else None
 
     def expr(self, expr: E.Expr):
         translated = self.shared.get(expr)
