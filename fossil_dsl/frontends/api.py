@@ -22,6 +22,7 @@ from fossil_dsl.outputs.result import Result, build_result, claim_of
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.fallback import FallbackBackend
 from fossil_dsl.solvers.positivstellensatz import BEFORE_Z3_FROM
+from fossil_dsl.ir.enclosure import import_codac
 from fossil_dsl.ir.spec import CheckedSpec
 
 # re-exported: specs built in Python are part of this API
@@ -56,7 +57,9 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
 # Lyapunov and Riccati solvers, the sum-of-squares programs, the solvers). Imported
 # before a run's clock starts, so that a run's time is its own work: 0.2-0.4 s of
 # imports had been most of a sub-second run's time (docs/benchmarks.md, session 41).
-RUN_LIBRARIES = ("scipy.linalg", "scipy.sparse", "clarabel", "codac", "cvc5", "z3")
+# codac is not among them: it is imported by import_codac(), which keeps the rounding
+# mode that codac's import changes.
+RUN_LIBRARIES = ("scipy.linalg", "scipy.sparse", "clarabel", "cvc5", "z3")
 
 
 def _import_run_libraries(plan: Plan) -> None:
@@ -66,6 +69,8 @@ def _import_run_libraries(plan: Plan) -> None:
     for name in RUN_LIBRARIES:
         if importlib.util.find_spec(name.partition(".")[0]) is not None:
             importlib.import_module(name)
+    if importlib.util.find_spec("codac") is not None:
+        import_codac()
 
 
 def _largest(plan: Plan, outcome, verdict: Verdict, pieces, started: float):

@@ -110,14 +110,14 @@ def change(expr: E.Expr, variables: Sequence[str], field: Sequence[E.Expr],
     """How expr changes along the dynamics: its Lie derivative for x' = field, or
     expr(field(x)) - expr(x) for x+ = field(x). Where that has functions (sin, tanh, ...)
     and expr is a polynomial, it is expanded over its atoms if that is small: V's large
-    terms then cancel exactly
-    (V = x'Px and a step x + h g(x) leave 2h x'P g + h^2 g'P g), where an enclosure of
-    the difference of the two large values would have to be narrow to see the small one
-    (d21: 4 states with sin, not proved in 300 s before, certified in 48 s). Polynomial
-    differences are left as they are: Z3, CVC5 and the sum-of-squares search expand them
-    themselves (expanded, d14's search took another path, 56 -> 104 s), and so are those
-    of networks with functions, which expanding only enlarges (row17's sigmoid barrier:
-    17 534 -> 21 654 nodes, its invariance proof 5 -> 24 s)."""
+    terms then cancel exactly (V = x'Px and a step x + h g(x) leave 2h x'P g + h^2 g'P g),
+    where an enclosure of the difference of the two large values would have to be narrow
+    to see the small one (d21: 4 states with sin, not proved in 300 s before, certified
+    in 48 s). Polynomial differences are left as they are: Z3, CVC5 and the
+    sum-of-squares search expand them themselves (expanded, d14's search took another
+    path, 56 -> 104 s), and so are those of networks with functions, which expanding
+    only enlarges (row17's sigmoid barrier: 17 534 -> 21 654 nodes, its invariance proof
+    5 -> 24 s)."""
     if not discrete:
         return lie_derivative(expr, variables, field)
     difference = E.add(compose(expr, variables, field), E.neg(expr))

@@ -16,6 +16,7 @@ import ctypes
 import ctypes.util
 import functools
 import math
+import sys
 from fractions import Fraction
 
 from fossil_dsl.ir import expr as E
@@ -32,12 +33,24 @@ def _libm():
 @functools.cache
 def _codac():
     """The codac module, and the rounding mode it needs (read when it is imported)."""
+    if "codac" in sys.modules:
+        # its import set the mode and nobody read it: upward_rounding() could not set it
+        # again, and codac's intervals would silently stop enclosing
+        raise RuntimeError("codac was imported before fossil_dsl.ir.enclosure read the "
+                           "rounding mode it needs: import it with import_codac()")
     libm = _libm()
     previous = libm.fegetround()
     import codac
     mode = libm.fegetround()
     libm.fesetround(previous)
     return codac, mode
+
+
+def import_codac() -> None:
+    """Import codac, keeping the process's rounding mode (importing codac directly
+    leaves the whole process rounding upwards: Python's floats then overflow to an
+    error where they should round to the largest double)."""
+    _codac()
 
 
 @contextlib.contextmanager

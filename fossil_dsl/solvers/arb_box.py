@@ -46,9 +46,7 @@ def _box(formula: L.Formula, names) -> tuple[dict, dict]:
 def _conjuncts(formula: L.Formula) -> list[L.Formula]:
     if isinstance(formula, L.And):
         return [atom for arg in formula.args for atom in _conjuncts(arg)]
-    if isinstance(formula, L.Not) and isinstance(formula.arg, L.Compare):
-        return [L.negated_inward(formula.arg)]  # the comparison, flipped
-    if isinstance(formula, L.Not):
+    if isinstance(formula, L.Not):  # negated inwards: a comparison flips, `or` splits
         return _conjuncts(L.negated_inward(formula.arg))
     return [formula]
 
