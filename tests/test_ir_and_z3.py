@@ -319,3 +319,41 @@ def test_cvc5_races_for_polynomial_counterexamples_that_z3_misses():
     assert time.monotonic() - started < 10
     point = {v: E.Num(answer.model[v]) for v in query.variables}
     assert L.truth(L.substitute(query.formula, point)) is True
+
+
+def test_a_z3_check_that_ignores_its_interrupt_is_left_behind(monkeypatch):
+    """The kernel asks Z3 in its own thread: a check that does not stop when interrupted
+    must not hold the run (discrete d10 overran its run's timeout, sessions 32 and 40)."""
+    import threading
+    import time
+    import z3
+    from fossil_dsl.solvers import z3_backend
+    monkeypatch.setattr(z3_backend, "ABANDON_AFTER", 0.2)
+    release = threading.Event()
+
+    class Deaf:  # a check that returns only when released, whatever it is told
+        def check(self):
+            release.wait(30)
+            return z3.unsat
+
+    class Context:
+        interrupts = 0
+
+        def interrupt(self):
+            Context.interrupts += 1
+
+    started = time.monotonic()
+    try:
+        assert z3_backend._check_with_deadline(Deaf(), Context(), 0.1) is None
+    finally:
+        release.set()
+    assert time.monotonic() - started < 5 and Context.interrupts == 1
+    stop = threading.Event()
+    stop.set()  # stopped from outside: interrupted at once, then left behind
+    release.clear()
+    started = time.monotonic()
+    try:
+        assert z3_backend._check_with_deadline(Deaf(), Context(), 60, stop) is None
+    finally:
+        release.set()
+    assert time.monotonic() - started < 5 and Context.interrupts == 2

@@ -21,6 +21,8 @@ from fossil_dsl.solvers.api import Answer, Status, UnsupportedTheory
 
 STOP_POLL = 0.02  # s between looks at whether to interrupt Z3
 KEYBOARD = "interrupted from keyboard"  # Z3's reason after Ctrl-C
+ABANDON_AFTER = 5.0  # s after its interrupt that a check still running is left behind
+LEFT_BEHIND = "Z3 did not stop when interrupted; its check was left behind"
 
 
 class Z3Converter:
@@ -117,6 +119,8 @@ class Z3Backend:
         solver.add(term, *converter.side_conditions)
         approximate = bool(converter.side_conditions)
         result = _check_with_deadline(solver, context, timeout, stop)
+        if result is None:
+            return Answer(Status.UNKNOWN, reason=LEFT_BEHIND)
         if result == z3.unsat:
             return Answer(Status.UNSAT, approximate=approximate)
         if result == z3.sat:
@@ -138,6 +142,8 @@ def check_smtlib(text: str, timeout: float) -> Answer:
     except z3.Z3Exception as exc:
         return Answer(Status.UNKNOWN, reason=f"Z3 could not read the script: {exc}")
     result = _check_with_deadline(solver, context, timeout)
+    if result is None:
+        return Answer(Status.UNKNOWN, reason=LEFT_BEHIND)
     if result == z3.unsat:
         return Answer(Status.UNSAT)
     if result == z3.sat:
@@ -147,27 +153,39 @@ def check_smtlib(text: str, timeout: float) -> Answer:
 
 def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
                          stop: threading.Event | None = None):
-    """solver.check(), interrupted from a watcher thread once `stop` is set, or if Z3
+    """solver.check() in a worker thread, interrupted once `stop` is set or once Z3
     overruns its own timeout (nlsat does not always look at the clock, e.g. on
-    high-degree polynomials)."""
+    high-degree polynomials). A check still running ABANDON_AFTER s after its interrupt
+    is left behind (a daemon thread) and the answer is unknown: the run goes on."""
     done, lock = threading.Event(), threading.Lock()
-    end = time.monotonic() + timeout + 1.0
+    found = {}
 
-    def watch():
-        while not done.wait(STOP_POLL):
-            if (stop is not None and stop.is_set()) or time.monotonic() > end:
-                with lock:  # never interrupt a context whose check has returned
-                    if not done.is_set():
-                        context.interrupt()
-                return
-
-    watcher = threading.Thread(target=watch, daemon=True)
-    watcher.start()
-    try:
+    def work():
         result = solver.check()
-    finally:
-        with lock:
+        with lock:  # never interrupt a context whose check has returned
+            found["result"] = result
             done.set()
+
+    worker = threading.Thread(target=work, daemon=True)
+    worker.start()
+    def interrupt():
+        with lock:
+            if not done.is_set():
+                context.interrupt()
+
+    end, interrupted = time.monotonic() + timeout + 1.0, None
+    try:
+        while not done.wait(STOP_POLL):
+            now = time.monotonic()
+            if interrupted is None and ((stop is not None and stop.is_set()) or now > end):
+                interrupt()
+                interrupted = now
+            elif interrupted is not None and now > interrupted + ABANDON_AFTER:
+                return None
+    except KeyboardInterrupt:  # Python's own handler ran: stop Z3 too
+        interrupt()
+        raise
+    result = found["result"]
     if result == z3.unknown and solver.reason_unknown() == KEYBOARD:
         # Z3 catches Ctrl-C itself, in whichever thread it runs: pass it on to the main
         # thread, where the run stops with what it has
