@@ -51,13 +51,20 @@ def constant(value, n: int) -> Polynomial:
 def add(*polynomials: Mapping[Monomial, Fraction]) -> Polynomial:
     result: Polynomial = {}
     for p in polynomials:
-        for monomial, coefficient in p.items():
-            total = result.get(monomial, Fraction(0)) + coefficient
-            if total:
-                result[monomial] = total
-            else:
-                result.pop(monomial, None)
+        accumulate(result, p)
     return result
+
+
+def accumulate(total: Polynomial, p: Mapping[Monomial, Fraction]) -> None:
+    """total += p, in place: a sum built term by term with `add` copies the whole sum at
+    each term (a degree-8 Gram matrix's polynomial in 4 states: 4 900 copies of up to
+    495 terms, 40 s of d18's run)."""
+    for monomial, coefficient in p.items():
+        value = total.get(monomial, Fraction(0)) + coefficient
+        if value:
+            total[monomial] = value
+        else:
+            total.pop(monomial, None)
 
 
 def scale(p: Mapping[Monomial, Fraction], factor) -> Polynomial:
@@ -146,7 +153,7 @@ def compose(p: Mapping[Monomial, Fraction], field: Sequence[Polynomial]) -> Poly
         term = constant(coefficient, n)
         for component, exponent in zip(field, monomial):
             term = multiply(term, power(component, exponent, n))
-        result = add(result, term)
+        accumulate(result, term)
     return result
 
 

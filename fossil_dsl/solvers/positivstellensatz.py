@@ -43,7 +43,7 @@ class SumOfSquares:
         for a, row in zip(self.monomials, self.gram):
             for b, entry in zip(self.monomials, row):
                 if entry:
-                    terms = P.add(terms, {P.times(a, b): entry})
+                    P.accumulate(terms, {P.times(a, b): entry})
         return terms
 
 
