@@ -357,3 +357,24 @@ def test_a_z3_check_that_ignores_its_interrupt_is_left_behind(monkeypatch):
     finally:
         release.set()
     assert time.monotonic() - started < 5 and Context.interrupts == 2
+
+
+def test_an_error_in_a_z3_check_reaches_the_caller_at_once():
+    """The check runs in a worker thread; its error is raised in the caller's, not turned
+    into an unknown answer after the timeout."""
+    import time
+    import z3
+    from fossil_dsl.solvers import z3_backend
+
+    class Failing:
+        def check(self):
+            raise z3.Z3Exception("broken")
+
+    class Context:
+        def interrupt(self):
+            pass
+
+    started = time.monotonic()
+    with pytest.raises(z3.Z3Exception, match="broken"):
+        z3_backend._check_with_deadline(Failing(), Context(), 60)
+    assert time.monotonic() - started < 2

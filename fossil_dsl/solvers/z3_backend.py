@@ -161,13 +161,17 @@ def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
     found = {}
 
     def work():
-        result = solver.check()
+        try:
+            result = solver.check()
+        except BaseException as exc:  # raised again in the caller's thread
+            result = exc
         with lock:  # never interrupt a context whose check has returned
             found["result"] = result
             done.set()
 
     worker = threading.Thread(target=work, daemon=True)
     worker.start()
+
     def interrupt():
         with lock:
             if not done.is_set():
@@ -186,6 +190,8 @@ def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
         interrupt()
         raise
     result = found["result"]
+    if isinstance(result, BaseException):
+        raise result
     if result == z3.unknown and solver.reason_unknown() == KEYBOARD:
         # Z3 catches Ctrl-C itself, in whichever thread it runs: pass it on to the main
         # thread, where the run stops with what it has
