@@ -218,6 +218,32 @@ def test_training_stops_when_the_exact_guard_samples_meet_the_condition():
     assert _met(torch.tensor([0.0, 0.0, 0.5]), level_set("B"), env)
 
 
+def test_a_conditions_loss_is_its_mean_shortfall_on_the_guards_band():
+    """On a level-set guard (B = 0, within a band of 0.1 times the mean |B| or |dB|,
+    whichever is larger) the loss is the mean of relu(claim's violation + margin); an
+    escapable guard lets a point meet it by leaving the level set (the smaller of the
+    two: relu(margin - |B|))."""
+    from fossil_dsl.engine.loss import condition_loss
+    from fossil_dsl.plan.certificates.base import Condition, level_set
+    from fossil_dsl.ir.sets import Box
+    from fossil_dsl.ir import expr as E
+    from fossil_dsl.ir import logic as L
+    env = {"$B": torch.tensor([0.0, 0.05, 3.0, -0.02], dtype=torch.float64),
+           "$dB": torch.tensor([0.3, -1.0, 0.5, 0.1], dtype=torch.float64)}
+    points = torch.zeros(4, 2, dtype=torch.float64)
+    region = Box((E.Num(-1), E.Num(-1)), (E.Num(1), E.Num(1)))  # not used by the loss
+    decreases = L.Compare("<", E.Var("$dB"), E.ZERO)
+    plain = Condition("flow", "", region, decreases, level_set("B"))
+    loss, met = condition_loss(plain, points, env, 0.2)
+    # band: 0.1 * max(mean|B| = 0.7675, mean|dB| = 0.475); samples 0, 1, 3 are in it
+    assert float(loss) == pytest.approx((0.5 + 0.0 + 0.3) / 3)
+    assert not met
+    escapable = Condition("flow", "", region, decreases, level_set("B"),
+                          escapable_guard=True)
+    loss, _ = condition_loss(escapable, points, env, 0.2)
+    assert float(loss) == pytest.approx((0.2 + 0.0 + 0.18) / 3)
+
+
 def _lyapunov_learner(dynamics: str):
     from fossil_dsl.engine.learner import Learner
     spec = spec_text(f"spec s\nstate x0, x1\ndynamics continuous {{\n{dynamics}\n}}\n"

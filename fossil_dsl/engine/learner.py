@@ -64,7 +64,10 @@ class Learner(ViolationSearch):
                                       outputs=len(c.inputs), centre=centre)
         self.conditions = {c.name: c for c in plan.conditions}
         self.digits = plan.options.digits  # of the last rounding
-        needed = set().union(*(placeholders(c) for c in plan.conditions))
+        # each condition's placeholders, collected once (walking its formulas each
+        # training step cost a tenth of the step)
+        self._placeholders = {c.name: placeholders(c) for c in plan.conditions}
+        needed = set().union(*self._placeholders.values())
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
         self.next_needed = any(next_value(s).name in needed for s in self.states)
         self.control_target, self.control_samples = self.controller_samples() \
@@ -233,7 +236,7 @@ class Learner(ViolationSearch):
             yield condition, points
 
     def _names_needed(self, conditions) -> list[str]:
-        needed = frozenset().union(*(placeholders(c) for c in conditions))
+        needed = frozenset().union(*(self._placeholders[c.name] for c in conditions))
         return [f for f in self._function_names
                 if value_of(f).name in needed or change_of(f).name in needed]
 

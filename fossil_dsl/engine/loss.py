@@ -36,33 +36,76 @@ def violation_of(claim: L.Formula, env) -> torch.Tensor:
     raise TypeError(f"a claim cannot be the constant {claim}")
 
 
+def guard_scale(env) -> float:
+    """The size of the batch's placeholder values (the mean of each one's magnitude, the
+    largest of them): a guard's band is relative to it."""
+    return max((float(v.detach().abs().mean()) for k, v in env.items()
+                if k.startswith("$") and isinstance(v, torch.Tensor) and v.dim() > 0),
+               default=1.0)
+
+
+def _detached(env) -> dict:
+    return {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
+
+
+class GuardMasks:
+    """Where a guard holds on one batch, loosened by bands relative to the batch's values;
+    each band's mask, and the scale, computed once (a training step asks for up to
+    three per condition)."""
+
+    def __init__(self, guard: L.Formula, env, batch: int):
+        self.guard, self.env, self.batch = guard, env, batch
+        self._scale, self._detached, self._masks = None, None, {}
+
+    def __call__(self, band: float) -> torch.Tensor:
+        if band not in self._masks:
+            self._masks[band] = self._mask(band)
+        return self._masks[band]
+
+    def _mask(self, band: float) -> torch.Tensor:
+        if self.guard == L.TRUE:
+            return torch.ones(self.batch, dtype=torch.bool)
+        if self._scale is None:
+            self._scale, self._detached = guard_scale(self.env), _detached(self.env)
+        return holds(self.guard, self._detached, self.batch, band * self._scale)
+
+    def judged(self) -> torch.Tensor:
+        """Where the condition is judged met or not: where the guard holds exactly, or,
+        for a guard that holds exactly on no sample (a level set, B(x) = 0), on the band
+        trained on."""
+        mask = self(0.0)
+        return mask if mask.any() else self(GUARD_BAND)
+
+
 def guard_mask(guard: L.Formula, env, batch: int, band: float) -> torch.Tensor:
-    if guard == L.TRUE:
-        return torch.ones(batch, dtype=torch.bool)
-    scale = max((float(v.detach().abs().mean()) for k, v in env.items()
-                 if k.startswith("$") and isinstance(v, torch.Tensor) and v.dim() > 0),
-                default=1.0)
-    detached = {k: v.detach() if isinstance(v, torch.Tensor) else v for k, v in env.items()}
-    return holds(guard, detached, batch, band * scale)
+    return GuardMasks(guard, env, batch)(band)
+
+
+class Shortfall:
+    """How far each sample is from meeting a condition's claim with a margin (0: met);
+    the claim's (and the guard's) violation evaluated once for every margin asked."""
+
+    def __init__(self, condition: Condition, env):
+        self.violation = violation_of(condition.claim, env)
+        self.guard_violation = violation_of(condition.guard, env) \
+            if condition.escapable_guard else None
+
+    def __call__(self, margin) -> torch.Tensor:
+        shortfall = torch.relu(self.violation + margin)
+        if self.guard_violation is not None:
+            escape = torch.relu(margin - self.guard_violation)
+            shortfall = torch.minimum(shortfall, escape)
+        return shortfall
 
 
 def shortfall_of(condition: Condition, env, margin) -> torch.Tensor:
-    """How far each sample is from meeting the claim with the margin (0: met)."""
-    shortfall = torch.relu(violation_of(condition.claim, env) + margin)
-    if condition.escapable_guard:
-        escape = torch.relu(margin - violation_of(condition.guard, env))
-        shortfall = torch.minimum(shortfall, escape)
-    return shortfall
+    return Shortfall(condition, env)(margin)
 
 
 def is_met(shortfall: torch.Tensor, guard: L.Formula, env) -> bool:
-    """Whether the condition is met on the samples where its guard holds exactly. A
-    guard that holds exactly on no sample (a level set, B(x) = 0) is judged on the band
-    trained on."""
-    mask = guard_mask(guard, env, len(shortfall), 0.0)
-    if not mask.any():
-        mask = guard_mask(guard, env, len(shortfall), GUARD_BAND)
-    return bool((shortfall[mask] == 0).all())
+    """Whether the condition is met on the samples where its guard holds exactly (a
+    guard that holds exactly on no sample is judged on the band trained on)."""
+    return bool((shortfall[GuardMasks(guard, env, len(shortfall)).judged()] == 0).all())
 
 
 def condition_loss(condition: Condition, points: torch.Tensor, env, margin: float):
@@ -71,13 +114,15 @@ def condition_loss(condition: Condition, points: torch.Tensor, env, margin: floa
     guard holds, or, for an escapable guard, with the margin on the whole band."""
     if condition.scaled_margin:
         margin = margin * (points ** 2).sum(1).detach()
-    mask = guard_mask(condition.guard, env, len(points), GUARD_BAND)
+    masks = GuardMasks(condition.guard, env, len(points))
+    mask = masks(GUARD_BAND)
     if not mask.any():
         return torch.zeros((), dtype=torch.float64), True
-    shortfall = shortfall_of(condition, env, margin)
+    shortfall_with = Shortfall(condition, env)
+    shortfall = shortfall_with(margin)
     if condition.escapable_guard:  # a point may meet it by leaving the guard's band
         satisfied = bool((shortfall[mask] == 0).all())
     else:
-        satisfied = is_met(shortfall_of(condition, env, margin / 2).detach(), condition.guard,
-                           env)
+        half = shortfall_with(margin / 2).detach()
+        satisfied = bool((half[masks.judged()] == 0).all())
     return shortfall[mask].mean(), satisfied
