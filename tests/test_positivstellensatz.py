@@ -149,3 +149,53 @@ def test_a_gram_matrix_polynomial_is_summed_in_place_to_the_same_polynomial():
     total = {(1, 0, 0): Fraction(2)}
     P.accumulate(total, {(1, 0, 0): Fraction(-2), (0, 1, 0): Fraction(1, 3)})
     assert total == {(0, 1, 0): Fraction(1, 3)}  # a cancelled term is gone, not zero
+
+
+# ---- a disjunction among the conjuncts: refuted case by case --------------------------
+def _on_the_unit_box_boundary_with_norm_at_most(bound):
+    """x in [-1, 1]^2, on one of its four faces, and x^2 + y^2 <= bound: unsatisfiable
+    for bound < 1 (every boundary point has norm at least 1), satisfiable for 1."""
+    box = [L.Compare(rel, side, E.Num(F(value))) for side in (X, Y)
+           for rel, value in ((">=", -1), ("<=", 1))]
+    interior = L.conjunction(*(L.Compare(rel, side, E.Num(F(value))) for side in (X, Y)
+                               for rel, value in ((">", -1), ("<", 1))))
+    return L.conjunction(*box, L.negation(interior), L.Compare("<=", NORM, E.Num(bound)))
+
+
+def test_a_query_with_a_disjunction_is_refuted_case_by_case_and_the_kernel_checks_the_cases():
+    import time
+    from fossil_dsl.solvers.positivstellensatz import CaseSplit
+    query = _on_the_unit_box_boundary_with_norm_at_most(F(9, 10))
+    found = sos_refutation.refute(query, STATES, time.monotonic() + 30)
+    assert isinstance(found, CaseSplit) and len(found.cases) == 4  # the four faces
+    assert refutation_problem(found, query, STATES) is None
+    assert refutation_problem(refutation_from_json(refutation_json(found, STATES)), query,
+                              STATES) is None
+    # the same cases do not refute a satisfiable query; a case left out, or the split
+    # named on a conjunct that is no disjunction, is refused
+    satisfiable = _on_the_unit_box_boundary_with_norm_at_most(F(1))
+    assert "case" in refutation_problem(found, satisfiable, STATES)
+    assert sos_refutation.refute(satisfiable, STATES, time.monotonic() + 30) is None
+    assert "refutations for 4 cases" in refutation_problem(
+        CaseSplit(found.conjunct, found.cases[1:]), query, STATES)
+    assert "not a disjunction" in refutation_problem(CaseSplit(0, found.cases), query, STATES)
+
+
+def test_the_kernel_proves_a_six_state_boundary_condition_case_by_case():
+    """V = |x|^2 > 0.9 on the boundary of [-1, 1]^6, the form of a region of attraction's
+    "V > β on the boundary of D": twelve faces, each a small program."""
+    from fossil_dsl.kernel.obligations import Obligation
+    from fossil_dsl.kernel.prove import SUM_OF_SQUARES, discharge
+    from fossil_dsl.solvers.positivstellensatz import CaseSplit
+    states = tuple(f"x{i}" for i in range(6))
+    xs = [E.Var(s) for s in states]
+    box = [L.Compare(rel, v, E.Num(F(value))) for v in xs
+           for rel, value in ((">=", -1), ("<=", 1))]
+    interior = L.conjunction(*(L.Compare(rel, v, E.Num(F(value))) for v in xs
+                               for rel, value in ((">", -1), ("<", 1))))
+    norm = E.add(*(sq(v) for v in xs))
+    query = L.conjunction(*box, L.negation(interior), L.Compare("<=", norm, E.Num(F(9, 10))))
+    proof = discharge(Obligation("condition:boundary", "V > 0.9 on the boundary of D", query),
+                      states, 30.0)
+    assert proof.proved and proof.procedure == SUM_OF_SQUARES
+    assert isinstance(proof.evidence, CaseSplit) and len(proof.evidence.cases) == 12

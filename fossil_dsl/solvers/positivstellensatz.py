@@ -15,6 +15,10 @@ the query held, every term would be >= 0 with sum 0, so every term 0; but c_k h_
 (or c > 0).
 So no point satisfies the query, and the obligation holds.
 
+A query with a disjunction among its conjuncts, C and (B_1 or ... or B_k) (a point on
+the boundary of a box is on one of its faces), is refuted case by case (CaseSplit): a
+refutation of each C and B_i, the cases computed here from the query.
+
 A query with elementary functions (sin, exp, ...) is first made polynomial by
 atom_facts.py: a variable per function application, and facts each such value
 satisfies; a refutation of that polynomial query refutes the query.
@@ -66,6 +70,38 @@ class Refutation:
     constant: Fraction = Fraction(0)  # c >= 0 added to the sum (the comparison 1 > 0)
 
 
+@dataclass(frozen=True)
+class CaseSplit:
+    """Refutations of the cases of the query's conjunct number `conjunct`, a disjunction:
+    one per disjunct, in order (see `cases`)."""
+
+    conjunct: int
+    cases: tuple["Refutation | CaseSplit", ...]
+
+
+Evidence = Refutation | CaseSplit
+
+
+def disjunction_branches(formula: L.Formula) -> tuple[L.Formula, ...] | None:
+    """The disjuncts of a disjunction (a negated conjunction pushed inward), else None."""
+    if isinstance(formula, L.Not):
+        formula = L.negated_inward(formula.arg)
+    return tuple(formula.args) if isinstance(formula, L.Or) else None
+
+
+def cases(query: L.Formula, index: int) -> list[L.Formula] | None:
+    """C and B_i for each disjunct B_i of the query's conjunct number `index` (C: the
+    other conjuncts); None where that conjunct is not a disjunction. The query holds at
+    a point exactly when one of the cases does."""
+    parts = conjuncts(query)
+    if not 0 <= index < len(parts):
+        return None
+    branches = disjunction_branches(parts[index])
+    if branches is None:
+        return None
+    return [L.conjunction(*parts[:index], branch, *parts[index + 1:]) for branch in branches]
+
+
 def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynomial, bool]]:
     """(h, strict) for each comparison h >= 0 / h > 0 among the query's conjuncts;
     raises ValueError where one is not polynomial, or where there is none.
@@ -114,9 +150,11 @@ def polynomial_form(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula,
     return abstracted(query, states)
 
 
-def refutation_problem(refutation: Refutation, query: L.Formula,
+def refutation_problem(refutation: Evidence, query: L.Formula,
                        states: Sequence[str]) -> str | None:
     """None if the refutation proves the query unsatisfiable; else what is wrong."""
+    if isinstance(refutation, CaseSplit):
+        return _case_split_problem(refutation, query, states)
     query, states = polynomial_form(query, states)
     try:
         atoms = comparisons(query, states)
@@ -152,6 +190,19 @@ def refutation_problem(refutation: Refutation, query: L.Formula,
     return None
 
 
+def _case_split_problem(split: CaseSplit, query: L.Formula, states) -> str | None:
+    found = cases(query, split.conjunct)
+    if found is None:
+        return f"conjunct {split.conjunct} of the query is not a disjunction"
+    if len(found) != len(split.cases):
+        return f"{len(split.cases)} refutations for {len(found)} cases"
+    for number, (case, refutation) in enumerate(zip(found, split.cases), 1):
+        problem = refutation_problem(refutation, case, states)
+        if problem is not None:
+            return f"case {number}: {problem}"
+    return None
+
+
 def positive_semidefinite(gram: Sequence[Sequence[Fraction]]) -> bool:
     """Exactly, by symmetric Gaussian elimination (LDL^T): no negative pivot, and a zero
     pivot only with a zero row."""
@@ -177,14 +228,20 @@ def positive_semidefinite(gram: Sequence[Sequence[Fraction]]) -> bool:
 
 
 # ---- the exported form (obligations/NAME.sos.json), which anyone can check again ----
-def refutation_json(refutation: Refutation, states: Sequence[str]) -> dict:
+def refutation_json(refutation: Evidence, states: Sequence[str]) -> dict:
+    if isinstance(refutation, CaseSplit):
+        return {"states": list(states), "conjunct": refutation.conjunct,
+                "cases": [refutation_json(r, states) for r in refutation.cases]}
     return {"states": list(states),
             "multipliers": [_multiplier_json(m) for m in refutation.multipliers],
             "rest": _square_json(refutation.rest), "constant": str(refutation.constant)}
 
 
-def refutation_from_json(data: dict) -> Refutation:
+def refutation_from_json(data: dict) -> Evidence:
     """Raises ValueError (or KeyError, TypeError) where the data is malformed."""
+    if "cases" in data:
+        return CaseSplit(int(data["conjunct"]),
+                         tuple(refutation_from_json(case) for case in data["cases"]))
     return Refutation(tuple(_multiplier(m) for m in data["multipliers"]),
                       _square(data["rest"]), Fraction(data.get("constant", "0")))
 

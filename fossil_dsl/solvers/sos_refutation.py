@@ -27,7 +27,9 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.solvers.api import Answer, Status
 from fossil_dsl.solvers.atom_facts import has_atoms, replaceable
-from fossil_dsl.solvers.positivstellensatz import (Power, Refutation, SumOfSquares, comparisons,
+from fossil_dsl.solvers.positivstellensatz import (CaseSplit, Evidence, Power, Refutation,
+                                                  SumOfSquares, cases, comparisons, conjuncts,
+                                                  disjunction_branches,
                                                   polynomial_form, positive_semidefinite,
                                                   refutation_problem)
 from fossil_dsl.solvers.sdp import Program
@@ -54,8 +56,44 @@ class SosBackend:
         return Answer(Status.UNSAT, solver=self.name, evidence=found)
 
 
-def refute(query: L.Formula, states, deadline: float) -> Refutation | None:
-    """A refutation of the query that checks exactly (see the module's text), or None."""
+def refute(query: L.Formula, states, deadline: float) -> Evidence | None:
+    """A refutation of the query that checks exactly (see the module's text), or None;
+    where the conjuncts without a disjunction are not refuted, one of the query's
+    disjunctions case by case (a point on a box's boundary is on one of its faces)."""
+    found = _refuted_conjunction(query, states, deadline)
+    if found is not None:
+        return found
+    for index in _disjunctions(query):
+        split = _refuted_cases(query, states, index, deadline)
+        if split is not None or time.monotonic() > deadline:
+            return split
+    return None
+
+
+MAX_CASES = 32  # disjuncts of a disjunction refuted case by case, at most
+
+
+def _disjunctions(query: L.Formula) -> list[int]:
+    """The indices of the query's conjuncts that are disjunctions of at most MAX_CASES
+    disjuncts, fewest disjuncts first."""
+    found = [(len(branches), index) for index, part in enumerate(conjuncts(query))
+             if (branches := disjunction_branches(part)) is not None
+             and len(branches) <= MAX_CASES]
+    return [index for _, index in sorted(found)]
+
+
+def _refuted_cases(query: L.Formula, states, index: int, deadline: float) -> CaseSplit | None:
+    found = []
+    for case in cases(query, index):
+        refutation = _refuted_conjunction(case, states, deadline)
+        if refutation is None:
+            return None
+        found.append(refutation)
+    split = CaseSplit(index, tuple(found))
+    return split if refutation_problem(split, query, states) is None else None
+
+
+def _refuted_conjunction(query: L.Formula, states, deadline: float) -> Refutation | None:
     abstract = has_atoms(query)
     if abstract and _least_abstracted_size(query, states) > ATOMS_MAX_VARIABLES:
         return None  # before abstracting and expanding: a tanh network's V has dozens
