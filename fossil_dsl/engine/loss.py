@@ -98,10 +98,6 @@ class Shortfall:
         return shortfall
 
 
-def shortfall_of(condition: Condition, env, margin) -> torch.Tensor:
-    return Shortfall(condition, env)(margin)
-
-
 def is_met(shortfall: torch.Tensor, guard: L.Formula, env) -> bool:
     """Whether the condition is met on the samples where its guard holds exactly (a
     guard that holds exactly on no sample is judged on the band trained on)."""

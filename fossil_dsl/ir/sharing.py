@@ -13,6 +13,7 @@ from collections import Counter
 from typing import Iterable
 
 from fossil_dsl.ir.expr import Expr, children
+from fossil_dsl.ir.traversal import children_first
 
 # A subexpression is named when naming it removes at least this share of the tree: an
 # auxiliary variable is one more dimension of every box and one more contractor, which a
@@ -25,7 +26,7 @@ def worth_naming(roots: Iterable[Expr], share: float = SHARE_WORTH_NAMING) -> li
     """The subexpressions to name, inner ones first: greedily the one whose naming removes
     the most tree nodes, while that is at least `share` of the tree left."""
     roots = tuple(roots)
-    order = _children_first(roots)
+    order = children_first(roots)
     named: list[Expr] = []
     while True:
         counts, sizes = _occurrences(roots, order, set(named))
@@ -45,21 +46,6 @@ def worth_naming(roots: Iterable[Expr], share: float = SHARE_WORTH_NAMING) -> li
 def _saving(node: Expr, counts: Counter, sizes: dict) -> int:
     # count copies of a size-node tree become count one-node names and one definition
     return (counts[node] - 1) * (sizes[node] - 1) - 1
-
-
-def _children_first(roots: tuple[Expr, ...]) -> list[Expr]:
-    order, seen = [], set()
-    for root in roots:
-        stack = [(root, False)]
-        while stack:
-            node, expanded = stack.pop()
-            if expanded:
-                order.append(node)
-            elif node not in seen:
-                seen.add(node)
-                stack.append((node, True))
-                stack.extend((child, False) for child in children(node))
-    return order
 
 
 def _occurrences(roots, order, named: set) -> tuple[Counter, dict]:

@@ -1,7 +1,7 @@
 """Rewriting and measuring expression trees."""
 from __future__ import annotations
 
-from typing import Mapping
+from typing import Iterable, Mapping
 
 from fossil_dsl.ir.expr import (Add, Apply, Div, Expr, Mul, Neg, Num, Pi, Pow, Var, add,
                                 apply, children, div, free_vars, mul, neg, power, walk)
@@ -98,17 +98,26 @@ def has_function(expr: Expr) -> bool:
     return any(isinstance(node, Apply) for node in distinct_nodes(expr))
 
 
+def children_first(roots: Iterable[Expr]) -> list[Expr]:
+    """The distinct subexpressions of the roots, each after its children."""
+    order, seen = [], set()
+    for root in roots:
+        stack = [(root, False)]
+        while stack:
+            node, expanded = stack.pop()
+            if expanded:
+                order.append(node)
+            elif node not in seen:
+                seen.add(node)
+                stack.append((node, True))
+                stack.extend((child, False) for child in children(node))
+    return order
+
+
 def tree_size(expr: Expr) -> int:
     """How many nodes the expression has written out as a tree (a subexpression counts
     once per occurrence): what an evaluator without shared results works through."""
     sizes: dict[Expr, int] = {}
-    stack = [expr]
-    while stack:  # children before parents
-        node = stack[-1]
-        waiting = [child for child in children(node) if child not in sizes]
-        if waiting:
-            stack.extend(waiting)
-            continue
-        stack.pop()
+    for node in children_first([expr]):
         sizes[node] = 1 + sum(sizes[child] for child in children(node))
     return sizes[expr]
