@@ -146,3 +146,32 @@ prove from init: stable
     result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=60)
     assert result.certified, result.summary()
     assert result.iterations == 1  # the seed itself, nothing learned
+
+
+def test_a_ball_of_initial_states_is_held_exactly_not_through_its_box():
+    """A ball I round the origin enters the ellipsoid's inequalities as Q >= r^2 I; its
+    box's corners lie sqrt(n) times as far out (twice, in 4 states), and with them no
+    ellipsoid fits between I and D here: the run learned for 60 s and was not certified."""
+    text = """\
+state a, b, c, d
+input u
+dynamics continuous {
+    a' = b
+    b' = c
+    c' = d
+    d' = u + 0.1*a^3
+}
+domain box([-1, -1, -1, -1], [1, 1, 1, 1])
+set init = ball([0, 0, 0, 0], 0.3)
+prove from init: stable
+"""
+    spec = fossil_dsl.loads(text)
+    A, B = jacobians(spec)
+    P, _ = ellipsoid(A, B, spec, discrete=False)
+    assert np.linalg.eigvalsh(P).max() * 0.3 ** 2 <= 1 + 1e-4  # the ball is inside {V <= 1}
+    boxed = fossil_dsl.loads(text.replace("ball([0, 0, 0, 0], 0.3)",
+                                          "box([-0.3, -0.3, -0.3, -0.3], [0.3, 0.3, 0.3, 0.3])"))
+    assert ellipsoid(A, B, boxed, discrete=False) is None
+    result = fossil_dsl.synthesise(spec, timeout=60)
+    assert result.certified, result.summary()
+    assert result.iterations == 1  # the seed itself

@@ -6,6 +6,7 @@ With Q = P^-1 and Y = K Q (u = K x), the classical linear matrix inequalities
     A Q + Q A^T + B Y + Y^T B^T + 2 a Q <= 0     (V = x^T P x decays at rate 2a; continuous)
     [[Q, (A Q + B Y)^T], [A Q + B Y, r^2 Q]] >= 0  (V(f(x)) <= r^2 V(x); maps)
     [[1, p^T], [p, Q]] >= 0 for each corner p of I's box   (I inside {V <= 1})
+    Q >= r^2 I instead where I is a ball of radius r round the origin
     Q_ii <= s d_i^2                                (the ellipsoid inside s D, D a box or ball)
     [[g, Y], [Y^T, Q]] >= 0  (|u| bounded on the ellipsoid, so the nonlinear terms stay small)
 
@@ -74,7 +75,16 @@ def _half_widths(domain, n: int) -> np.ndarray | None:
     return d if (d > 0).all() else None
 
 
-def _corners(initial, n: int) -> np.ndarray | None:
+def _corners(initial, n: int) -> np.ndarray | float | None:
+    """The corners of I's box, or, for a ball round the origin, its radius r: the ball is
+    inside {x^T Q^-1 x <= 1} exactly when Q >= r^2 I, where its box's corners (sqrt(n)
+    times as far out: 2.6 times for w09's 7 states) would ask far more of the ellipsoid."""
+    while isinstance(initial, S.Named):
+        initial = initial.value
+    if isinstance(initial, S.Ball):
+        low, high = (np.asarray(side, float) for side in initial.bounding_box())
+        if not np.any(low + high):
+            return float(high[0])
     box = initial.bounding_box() if initial is not None else None
     if box is None or 2 ** n > MAX_CORNERS:
         return None
@@ -97,6 +107,9 @@ def _solve(A, B, d, corners, discrete: bool, rate: float):
     else:
         lmi.block(n, lambda i, j: _scaled(_sum([C[i][j], C[j][i],
                                                 _scaled(Q[i][j], 2 * rate)]), -1.0))
+    if isinstance(corners, float):  # I is a ball of this radius round the origin
+        lmi.block(n, lambda i, j: _sum([Q[i][j], ({}, -corners ** 2 if i == j else 0.0)]))
+        corners = ()
     for p in corners:
         lmi.block(n + 1, lambda i, j, p=p: ({}, 1.0) if j == 0 else ({}, float(p[j - 1]))
                   if i == 0 else Q[i - 1][j - 1])

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from typing import Callable
 
+from fossil_dsl.engine.falsify import Falsifier
 from fossil_dsl.engine.given import GivenFunctions, verifier_only
 from fossil_dsl.plan.certificates.base import change_of, level_of, next_value, value_of
 from fossil_dsl.ir import calculus
@@ -135,6 +136,9 @@ class Cegis:
         self.states = plan.states
         self.options = plan.options
         self.learner = GivenFunctions(plan) if verifier_only(plan) else self._learner()
+        # runs that learn look for counterexamples numerically where the verifier is slow
+        self.falsifier = None if isinstance(self.learner, GivenFunctions) else \
+            Falsifier(self.states, plan.spec.domain.bounding_box(), self.options.seed)
         self.deadline = deadline or time.monotonic() + self.options.timeout
 
     def _learner(self):
@@ -268,10 +272,19 @@ class Cegis:
             query = L.substitute(self.plan.query(condition), mapping)
             queries[condition.name] = query
             budget = max(1.0, min(self.options.query_timeout, self.deadline - time.monotonic()))
-            answer = _decided(query, self.states) or \
-                self.backend.check(query, self.states, budget)
+            answer = _decided(query, self.states) or self._checked(condition.name, query, budget)
             verdicts.append(_verdict(condition.name, answer, self.states, self.backend.name))
         return tuple(verdicts), queries, time.monotonic() - started
+
+    def _checked(self, name: str, query: L.Formula, budget: float) -> Answer:
+        if self.falsifier is None:
+            return self.backend.check(query, self.states, budget)
+        found = self.falsifier.first(name, query)
+        if found is not None:
+            return found
+        started = time.monotonic()
+        answer = self.backend.check(query, self.states, budget)
+        return self.falsifier.after(name, query, answer, time.monotonic() - started)
 
     def learn_from(self, verdicts) -> None:
         for verdict in verdicts:

@@ -1,0 +1,90 @@
+"""The numeric search for counterexamples (engine/falsify.py): the points it returns
+satisfy the query exactly, it finds slivers that uniform samples miss, it returns
+nothing for an unsatisfiable query, and the loop's trigger (first for many states or
+after a slow query; after an UNKNOWN) behaves as documented."""
+from fractions import Fraction
+
+from fossil_dsl.engine.falsify import FIRST_FROM_STATES, SLOW_QUERY, SOLVER, Falsifier, witness
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.solvers.api import Answer, Status
+
+SIX = [f"x{i}" for i in range(1, 7)]
+
+
+def _var(name):
+    return E.Var(name)
+
+
+def _squared_norm(states):
+    return E.add(*(E.power(_var(s), E.Num(2)) for s in states))
+
+
+def _in_box(states, low, high):
+    return L.conjunction(*(L.conjunction(L.Compare(">=", _var(s), E.Num(low)),
+                                         L.Compare("<=", _var(s), E.Num(high)))
+                           for s in states))
+
+
+def _exactly_true(query, states, point) -> bool:
+    exact = {s: E.Num(Fraction(v)) for s, v in zip(states, point)}
+    return L.truth(L.substitute(query, exact)) is True
+
+
+def _shell_sliver():
+    """A shell of width 0.0005 round radius 0.3 in six states, one orthant's part: about
+    1e-8 of the box, so uniform samples never land in it."""
+    return L.conjunction(
+        _in_box(SIX, -2, 2),
+        L.Compare(">=", _squared_norm(SIX), E.Num(Fraction(9, 100))),
+        L.Compare("<=", _squared_norm(SIX), E.Num(Fraction(903, 10000))),
+        L.Compare(">=", _var("x1"), E.Num(Fraction(1, 10))),
+        L.Compare("<", _var("x2"), E.Num(Fraction(-1, 10))))
+
+
+def test_a_witness_satisfies_the_query_exactly_even_in_a_sliver():
+    query = _shell_sliver()
+    point = witness(query, SIX, ([-2] * 6, [2] * 6), seed=0)
+    assert point is not None
+    assert _exactly_true(query, SIX, point)
+
+
+def test_no_witness_for_an_unsatisfiable_query():
+    query = L.conjunction(_in_box(SIX, -2, 2),
+                          L.Compare("<=", E.add(_squared_norm(SIX), E.Num(1)), E.Num(Fraction(1, 2))))
+    assert witness(query, SIX, ([-2] * 6, [2] * 6), seed=0) is None
+
+
+def test_undefined_values_are_far_not_witnesses():
+    """log(x) is undefined for x <= 0, where the points start half the time: NaN must
+    count as far from holding, and the point found lies where log is defined."""
+    x = _var("x")
+    query = L.conjunction(_in_box(["x"], -1, 1),
+                          L.Compare("<=", E.apply("log", x), E.Num(-1)))
+    point = witness(query, ["x"], ([-1], [1]), seed=1)
+    assert point is not None and 0 < point[0] <= 0.3679
+
+
+def test_the_falsifier_searches_first_only_where_bisection_is_slow():
+    two = ["x", "y"]
+    query = L.conjunction(_in_box(two, -1, 1), L.Compare(">=", _var("x"), E.Num(Fraction(1, 2))))
+    falsifier = Falsifier(two, ([-1, -1], [1, 1]), seed=0)
+    assert falsifier.first("decrease", query) is None  # two states, never slow yet
+    proved = Answer(Status.UNSAT)
+    assert falsifier.after("decrease", query, proved, SLOW_QUERY + 1) is proved
+    found = falsifier.first("decrease", query)  # slow once: searched first from now on
+    assert found.status is Status.SAT and found.solver == SOLVER
+    assert _exactly_true(query, two, [found.model[s] for s in two])
+    assert FIRST_FROM_STATES <= 6
+    assert Falsifier(SIX, ([-2] * 6, [2] * 6), 0).first("boundary", _shell_sliver()) is not None
+
+
+def test_an_unknown_answer_becomes_a_counterexample_where_one_is_found():
+    two = ["x", "y"]
+    query = L.conjunction(_in_box(two, -1, 1), L.Compare(">=", _var("y"), E.Num(Fraction(9, 10))))
+    falsifier = Falsifier(two, ([-1, -1], [1, 1]), seed=0)
+    unknown = Answer(Status.UNKNOWN, reason="timeout")
+    assert falsifier.after("initial", query, unknown, 1.0).status is Status.SAT
+    impossible = L.conjunction(_in_box(two, -1, 1), L.Compare(">=", _var("y"), E.Num(2)))
+    assert falsifier.after("initial", impossible, unknown, 1.0) is unknown
+    assert "initial" not in falsifier.slow
