@@ -247,6 +247,43 @@ def test_fallback_runs_both_solvers_at_once_and_the_first_answer_stops_the_other
     assert answer.solver == "z3"  # answered within its head start: the second never ran
 
 
+def test_a_point_where_the_query_is_exactly_false_does_not_win_the_race(monkeypatch):
+    """The interval procedure's delta-sat point near the origin, where x^2 < 0 is false
+    when evaluated exactly, is no answer: the other solver's UNSAT is waited for; and
+    where that never comes, the point is returned after SPURIOUS_WAIT, flagged."""
+    import time
+    from fractions import Fraction
+    from fossil_dsl.solvers import fallback
+    from fossil_dsl.solvers.api import Answer
+    x = E.Var("x0")
+    never_below = L.Compare("<", E.mul(x, x), E.ZERO)
+    spurious = Answer(Status.SAT, {"x0": Fraction(1, 10000)}, reason="delta-sat")
+    assert not fallback.definite(spurious, never_below)
+    assert fallback.definite(Answer(Status.SAT, {"x0": Fraction(-1)}), L.Compare("<", x, E.ZERO))
+    exact = Slow("z3", Answer(Status.UNSAT), seconds=2)
+    quick = Slow("interval", spurious, seconds=0)
+    answer = fallback.FallbackBackend(exact, quick).check(never_below, ["x0"], 60)
+    assert answer.status is Status.UNSAT and answer.solver == "z3" and not exact.stopped
+    monkeypatch.setattr(fallback, "SPURIOUS_WAIT", 1.0)
+    stuck = Slow("z3", Answer(Status.UNSAT), seconds=30)
+    started = time.monotonic()
+    answer = fallback.FallbackBackend(stuck, quick).check(never_below, ["x0"], 60)
+    assert answer.status is Status.SAT and "not a solution when evaluated exactly" in answer.reason
+    assert time.monotonic() - started < 5
+    time.sleep(0.2)  # the leader's thread sees the stop
+    assert stuck.stopped
+
+
+def test_a_decrease_that_intervals_cannot_refute_at_the_origin_is_proved_at_once():
+    """probe43/x06: the interval procedure's delta-sat points at 1e-4 of the origin won
+    the race against CVC5 in each of 20 iterations (49 s); now the first candidate is
+    proved."""
+    text = (ROOT / "specs/probe43/x06_rational_map_stable_3d.fsl").read_text()
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=90)
+    assert result.certified, result.summary()
+    assert result.iterations == 1
+
+
 def test_fallback_passes_a_stop_from_outside_on_to_both_solvers():
     import threading
     import time

@@ -9,6 +9,13 @@ HEAD_START seconds (most of its answers come sooner); then the second starts on 
 query in this thread while the first goes on in its own, and the first definite answer
 (SAT or UNSAT) wins and stops the other. Each answer names the solver that gave it.
 
+A delta-SAT point where a polynomial query is false when evaluated exactly is no answer:
+near the origin, where a decrease V(f(x)) - V(x) < 0 is of order |x|^2, the interval
+procedure's boxes of width 1e-4 are never refuted, and such points won the race every
+iteration (probe43/x06: 20 iterations, each learning from a point at 1e-4 of the origin,
+before CVC5 proved the condition in 4 s). After one, the other solver is waited for (at
+most SPURIOUS_WAIT seconds); the point is returned only if it gives no answer either.
+
 CEGIS asks the same condition again after each learning step, with new weights. Once the
 second solver has won on a query of some form, later queries of that form (the same
 formula with other numbers) give it the head start instead.
@@ -18,6 +25,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import replace
+from fractions import Fraction
 from typing import Sequence
 
 from fossil_dsl.ir import expr as E
@@ -29,6 +37,7 @@ HEAD_START = 0.5  # s the leading solver runs alone before the other joins it
 # (its thread is a daemon): a Z3 check that does not heed its interrupt must not hold
 # the run past its own timeout
 ABANDON_AFTER = 5.0
+SPURIOUS_WAIT = 15.0  # s the other solver is still given after a point that is no answer
 
 
 class FallbackBackend:
@@ -60,7 +69,7 @@ def _race(leader: Backend, follower: Backend, formula, variables, timeout: float
 
     def lead():
         answers["leader"] = _ask(leader, formula, variables, timeout, finished)
-        if answers["leader"].status is not Status.UNKNOWN:
+        if definite(answers["leader"], formula):
             finished.set()
 
     thread = threading.Thread(target=lead, daemon=True)
@@ -70,9 +79,12 @@ def _race(leader: Backend, follower: Backend, formula, variables, timeout: float
     if not finished.is_set():
         left = max(0.0, timeout - (time.monotonic() - started))
         answers["follower"] = _ask(follower, formula, variables, left, finished)
-        if answers["follower"].status is not Status.UNKNOWN:
+        if definite(answers["follower"], formula):
             finished.set()
-    thread.join(max(0.0, started + timeout + ABANDON_AFTER - time.monotonic()))
+    wait = max(0.0, started + timeout + ABANDON_AFTER - time.monotonic())
+    if answers.get("follower", Answer(Status.UNKNOWN)).status is Status.SAT:
+        wait = min(wait, SPURIOUS_WAIT)  # a point that is no answer: not the whole time
+    thread.join(wait)
     finished.set()  # ends the relay
     if relay is not None:
         relay.join()
@@ -80,7 +92,7 @@ def _race(leader: Backend, follower: Backend, formula, variables, timeout: float
     if "leader" not in answered:
         answered["leader"] = Answer(Status.UNKNOWN, reason=f"{leader.name} had not stopped "
                                     f"{ABANDON_AFTER:g} s past its time limit; left behind")
-    return _outcome(leader, follower, answered)
+    return _outcome(leader, follower, answered, formula)
 
 
 def _relay(stop: threading.Event, finished: threading.Event) -> threading.Thread:
@@ -94,18 +106,36 @@ def _relay(stop: threading.Event, finished: threading.Event) -> threading.Thread
     return thread
 
 
-def _outcome(leader, follower, answers) -> tuple[Answer, Backend | None]:
+def _outcome(leader, follower, answers, formula) -> tuple[Answer, Backend | None]:
     lead, follow = answers["leader"], answers.get("follower")
-    if lead.status is not Status.UNKNOWN:
+    if definite(lead, formula):
         return lead, leader
-    if follow is not None and follow.status is not Status.UNKNOWN:
+    if follow is not None and definite(follow, formula):
         return replace(follow, reason=f"{leader.name} had not answered "
                        f"({lead.reason}); {follow.reason or 'decided'} by {follower.name}"), \
             follower
+    for point in (lead, follow):  # no answer: a point to learn from is still worth having
+        if point is not None and point.status is Status.SAT:
+            return replace(point, reason=f"{point.reason} (not a solution when evaluated "
+                           "exactly; neither solver decided)"), None
     reasons = [f"{leader.name}: {lead.reason}"]
     if follow is not None:
         reasons.append(f"{follower.name}: {follow.reason}")
     return Answer(Status.UNKNOWN, reason="; ".join(reasons)), None
+
+
+def definite(answer: Answer, formula: L.Formula) -> bool:
+    """UNSAT, or SAT at a point where the formula holds exactly, or cannot be evaluated
+    exactly (it has functions such as sin): not a point where it is exactly false."""
+    if answer.status is Status.UNSAT:
+        return True
+    if answer.status is not Status.SAT or not answer.model:
+        return answer.status is Status.SAT
+    try:
+        exact = {name: E.Num(Fraction(value)) for name, value in answer.model.items()}
+    except (TypeError, ValueError):  # a value that is no rational number: not judged
+        return True
+    return L.truth(L.substitute(formula, exact)) is not False
 
 
 def _ask(backend: Backend, formula, variables, timeout: float, stop) -> Answer:
