@@ -77,6 +77,9 @@ def test_the_falsifier_searches_first_only_where_bisection_is_slow():
     assert _exactly_true(query, two, [found.model[s] for s in two])
     assert FIRST_FROM_STATES <= 6
     assert Falsifier(SIX, ([-2] * 6, [2] * 6), 0).first("boundary", _shell_sliver()) is not None
+    # with Z3 (complete on polynomials, quick to find points) only after a slow query
+    assert Falsifier(SIX, ([-2] * 6, [2] * 6), 0, bisecting=False).first(
+        "boundary", _shell_sliver()) is None
 
 
 def test_an_unknown_answer_becomes_a_counterexample_where_one_is_found():

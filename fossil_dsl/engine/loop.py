@@ -22,6 +22,7 @@ from fossil_dsl.ir.atoms import folded
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.ir.numbers import rational
 from fossil_dsl.plan.compile import Plan
+from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.api import Answer, Backend, Status
 
 
@@ -138,7 +139,8 @@ class Cegis:
         self.learner = GivenFunctions(plan) if verifier_only(plan) else self._learner()
         # runs that learn look for counterexamples numerically where the verifier is slow
         self.falsifier = None if isinstance(self.learner, GivenFunctions) else \
-            Falsifier(self.states, plan.spec.domain.bounding_box(), self.options.seed)
+            Falsifier(self.states, plan.spec.domain.bounding_box(), self.options.seed,
+                      registry.BACKENDS[plan.verifier].delta_decision)
         self.deadline = deadline or time.monotonic() + self.options.timeout
 
     def _learner(self):
