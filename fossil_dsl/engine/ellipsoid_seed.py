@@ -43,13 +43,15 @@ def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
     weakest feasible one), or None where the sets are not boxes or balls round the
     origin's neighbourhood, or the inequalities are infeasible, or s >= 1."""
     half_widths = _half_widths(spec.domain, len(A))
-    corners = _corners(spec.property.role("initial"), len(A))
+    initial = spec.property.role("initial")
+    radius = _ball_radius(initial)
+    corners = np.empty((0, len(A))) if radius else _corners(initial, len(A))
     if half_widths is None or corners is None:
         return None
     last = None
     for rate in CONTRACTIONS if discrete else DECAYS:
         try:
-            found = _solve(A, B, half_widths, corners, discrete, rate)
+            found = _solve(A, B, half_widths, corners, radius, discrete, rate)
         except (ValueError, np.linalg.LinAlgError):  # numerical trouble: no seed
             return None
         if found is not None and found[2] <= ROOM:
@@ -75,23 +77,26 @@ def _half_widths(domain, n: int) -> np.ndarray | None:
     return d if (d > 0).all() else None
 
 
-def _corners(initial, n: int) -> np.ndarray | float | None:
-    """The corners of I's box, or, for a ball round the origin, its radius r: the ball is
-    inside {x^T Q^-1 x <= 1} exactly when Q >= r^2 I, where its box's corners (sqrt(n)
-    times as far out: 2.6 times for w09's 7 states) would ask far more of the ellipsoid."""
+def _ball_radius(initial) -> float | None:
+    """r where I is a ball of radius r round the origin: it is inside {x^T Q^-1 x <= 1}
+    exactly when Q >= r^2 I, where its box's corners (sqrt(n) times as far out: 2.6 times
+    for w09's 7 states) would ask far more of the ellipsoid."""
     while isinstance(initial, S.Named):
         initial = initial.value
-    if isinstance(initial, S.Ball):
-        low, high = (np.asarray(side, float) for side in initial.bounding_box())
-        if not np.any(low + high):
-            return float(high[0])
+    if not isinstance(initial, S.Ball):
+        return None
+    low, high = (np.asarray(side, float) for side in initial.bounding_box())
+    return None if np.any(low + high) else float(high[0])
+
+
+def _corners(initial, n: int) -> np.ndarray | None:
     box = initial.bounding_box() if initial is not None else None
     if box is None or 2 ** n > MAX_CORNERS:
         return None
     return np.array(list(itertools.product(*zip(box[0], box[1]))), dtype=float)
 
 
-def _solve(A, B, d, corners, discrete: bool, rate: float):
+def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float):
     n, m = B.shape
     lmi = _Inequalities(n)
     Q = lmi.symmetric(n)  # positive semidefinite
@@ -107,9 +112,8 @@ def _solve(A, B, d, corners, discrete: bool, rate: float):
     else:
         lmi.block(n, lambda i, j: _scaled(_sum([C[i][j], C[j][i],
                                                 _scaled(Q[i][j], 2 * rate)]), -1.0))
-    if isinstance(corners, float):  # I is a ball of this radius round the origin
-        lmi.block(n, lambda i, j: _sum([Q[i][j], ({}, -corners ** 2 if i == j else 0.0)]))
-        corners = ()
+    if radius:  # I is a ball round the origin: Q - r^2 I >= 0
+        lmi.block(n, lambda i, j: _sum([Q[i][j], ({}, -radius ** 2 if i == j else 0.0)]))
     for p in corners:
         lmi.block(n + 1, lambda i, j, p=p: ({}, 1.0) if j == 0 else ({}, float(p[j - 1]))
                   if i == 0 else Q[i - 1][j - 1])

@@ -81,16 +81,16 @@ def witness(query: L.Formula, states, box, seed: int) -> list[float] | None:
         distance = _distance(query, states, points)
         distance.sum().backward()
         optimiser.step()
+        with torch.no_grad():
+            points.clamp_(min=low, max=high)
+        found = _holding(query, states, points.detach())
+        if found is not None:
+            return found
         nearest = float(distance.detach().min())
         since = 0 if nearest < closest else since + 1
         closest = min(closest, nearest)
         if since >= PATIENCE:
             return None
-        with torch.no_grad():
-            points.copy_(torch.maximum(torch.minimum(points, high), low))
-        found = _holding(query, states, points.detach())
-        if found is not None:
-            return found
     return None
 
 
