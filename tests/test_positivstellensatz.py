@@ -199,3 +199,40 @@ def test_the_kernel_proves_a_six_state_boundary_condition_case_by_case():
                       states, 30.0)
     assert proof.proved and proof.procedure == SUM_OF_SQUARES
     assert isinstance(proof.evidence, CaseSplit) and len(proof.evidence.cases) == 12
+
+
+# x and y in the box [-1, 1]^2 with x^2 + y^2 > 2.5: unsatisfiable, but multipliers of the
+# four linear bounds alone cannot show it at degree 2 (nothing there sees x^2 <= 1); the
+# products of opposite bounds, (x + 1)(1 - x) >= 0 and (y + 1)(1 - y) >= 0, can
+ONE = E.Num(F(1))
+BOX_AND_FAR = L.conjunction(L.Compare("<=", E.neg(ONE), X), L.Compare("<=", X, ONE),
+                            L.Compare("<=", E.neg(ONE), Y), L.Compare("<=", Y, ONE),
+                            L.Compare(">", NORM, E.Num(F(5, 2))))
+
+
+def test_opposite_bounds_enter_as_products_and_the_kernel_checks_them():
+    import time
+    found = sos_refutation.refute(BOX_AND_FAR, STATES, time.monotonic() + 30)
+    assert found is not None and {(p.first, p.second) for p in found.products} == {(0, 1), (2, 3)}
+    assert refutation_problem(found, BOX_AND_FAR, STATES) is None
+    again = refutation_from_json(refutation_json(found, STATES))
+    assert again == found and refutation_problem(again, BOX_AND_FAR, STATES) is None
+    without = Refutation(found.multipliers, found.rest, found.constant)
+    assert "identity fails" in refutation_problem(without, BOX_AND_FAR, STATES)
+
+
+def test_forged_products_are_rejected():
+    import time
+    from dataclasses import replace
+    found = sos_refutation.refute(BOX_AND_FAR, STATES, time.monotonic() + 30)
+    product = found.products[0]
+    elsewhere = replace(found, products=(replace(product, second=7),) + found.products[1:])
+    assert "does not have" in refutation_problem(elsewhere, BOX_AND_FAR, STATES)
+    size = len(product.square.monomials)
+    negative = tuple(tuple(F(-1) if i == j else F(0) for j in range(size)) for i in range(size))
+    indefinite = replace(found, products=(replace(product, square=replace(
+        product.square, gram=negative)),) + found.products[1:])
+    assert "not positive semidefinite" in refutation_problem(indefinite, BOX_AND_FAR, STATES)
+    # a product of comparisons that are not the box's bounds: the identity no longer holds
+    swapped = replace(found, products=(replace(product, first=0, second=2),) + found.products[1:])
+    assert refutation_problem(swapped, BOX_AND_FAR, STATES) is not None

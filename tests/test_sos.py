@@ -1,6 +1,7 @@
 """The sum-of-squares first attempt: a Lyapunov function for polynomial systems from a
 semidefinite program (Clarabel), rounded to rationals and proved like any candidate."""
 import time
+from pathlib import Path
 
 import pytest
 import sympy
@@ -310,3 +311,19 @@ def test_a_map_whose_decrease_z3_cannot_decide_is_proved_outside_a_lemma_ball():
     assert result.strategy.startswith("sum-of-squares programming")
     assert "asymptotically stable" in result.guarantee()
     assert "ε" not in result.guarantee() and "epsilon" not in result.guarantee()
+
+
+COUPLED_REVERSED_VAN_DER_POL = (Path(__file__).parent.parent / "specs" / "probe44"
+                                / "y02_coupled_reversed_vdp_roa_4d.fsl")
+
+
+def test_a_quartic_v_found_with_box_products_is_refuted_with_them_too():
+    """The program finds a degree-4 V with the products of the box's opposite bounds;
+    its decrease has a refutation only with those products too (without them: 60 s of
+    solvers timing out, then learning)."""
+    result = fossil_dsl.synthesise(fossil_dsl.load(COUPLED_REVERSED_VAN_DER_POL), timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming")
+    decrease = next(p for p in result.kernel.proofs
+                    if p.obligation.name == "condition:decrease")
+    assert decrease.proved and getattr(decrease.evidence, "products", ())

@@ -7,9 +7,12 @@ query's order, a multiplier for each comparison: none, a rational constant c >= 
 c h^(m-1), making the term c h^m), or a sum of squares m(x)^T G m(x) (G rational and
 positive semidefinite); and a sum of squares s0. It refutes the query when
 
-    s0(x) + sum_j sigma_j(x) h_j(x) = 0 for every x  (every coefficient cancels exactly)
+    s0(x) + sum_j sigma_j(x) h_j(x) + sum_(i,k) sigma_ik(x) h_i(x) h_k(x) = 0 for every x
+                                               (every coefficient cancels exactly)
 
-and some strict comparison h_k > 0 has a constant multiplier c_k > 0 (or c_k h_k^(m-1)),
+(the sigma_ik are sums of squares for chosen pairs of comparisons, such as a box's
+lower and upper bound on one state: h_i h_k >= 0 wherever both hold), and some strict
+comparison h_k > 0 has a constant multiplier c_k > 0 (or c_k h_k^(m-1)),
 or a constant c > 0 is added to the sum (the strict comparison 1 > 0). At a point where
 the query held, every term would be >= 0 with sum 0, so every term 0; but c_k h_k^m > 0
 (or c > 0).
@@ -64,10 +67,20 @@ Multiplier = Fraction | Power | SumOfSquares | None
 
 
 @dataclass(frozen=True)
+class Product:
+    """sigma h_first h_second: a sum of squares times the product of two comparisons."""
+
+    first: int
+    second: int
+    square: SumOfSquares
+
+
+@dataclass(frozen=True)
 class Refutation:
     multipliers: tuple[Multiplier, ...]  # one per comparison of the query, in order
     rest: SumOfSquares  # s0
     constant: Fraction = Fraction(0)  # c >= 0 added to the sum (the comparison 1 > 0)
+    products: tuple[Product, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -162,13 +175,19 @@ def refutation_problem(refutation: Evidence, query: L.Formula,
         return f"the query is not a conjunction of polynomial comparisons ({exc})"
     if len(refutation.multipliers) != len(atoms):
         return f"{len(refutation.multipliers)} multipliers for {len(atoms)} comparisons"
+    if any(not 0 <= i < len(atoms) for p in refutation.products for i in (p.first, p.second)):
+        return "a product names a comparison the query does not have"
     squares = [refutation.rest] + [m for m in refutation.multipliers
-                                   if isinstance(m, SumOfSquares)]
+                                   if isinstance(m, SumOfSquares)] \
+        + [p.square for p in refutation.products]
     if not all(positive_semidefinite(s.gram) for s in squares):
         return "a Gram matrix is not positive semidefinite"
     if refutation.constant < 0:
         return "the constant is negative"
     total = P.add(refutation.rest.polynomial(), P.constant(refutation.constant, len(states)))
+    for product in refutation.products:
+        pair = P.multiply(atoms[product.first][0], atoms[product.second][0])
+        total = P.add(total, P.multiply(product.square.polynomial(), pair))
     strict = refutation.constant > 0
     for (h, is_strict), multiplier in zip(atoms, refutation.multipliers):
         if multiplier is None:
@@ -232,9 +251,13 @@ def refutation_json(refutation: Evidence, states: Sequence[str]) -> dict:
     if isinstance(refutation, CaseSplit):
         return {"states": list(states), "conjunct": refutation.conjunct,
                 "cases": [refutation_json(r, states) for r in refutation.cases]}
-    return {"states": list(states),
-            "multipliers": [_multiplier_json(m) for m in refutation.multipliers],
-            "rest": _square_json(refutation.rest), "constant": str(refutation.constant)}
+    found = {"states": list(states),
+             "multipliers": [_multiplier_json(m) for m in refutation.multipliers],
+             "rest": _square_json(refutation.rest), "constant": str(refutation.constant)}
+    if refutation.products:
+        found["products"] = [{"comparisons": [p.first, p.second], "square": _square_json(p.square)}
+                             for p in refutation.products]
+    return found
 
 
 def refutation_from_json(data: dict) -> Evidence:
@@ -242,8 +265,10 @@ def refutation_from_json(data: dict) -> Evidence:
     if "cases" in data:
         return CaseSplit(int(data["conjunct"]),
                          tuple(refutation_from_json(case) for case in data["cases"]))
+    products = tuple(Product(int(p["comparisons"][0]), int(p["comparisons"][1]),
+                             _square(p["square"])) for p in data.get("products", ()))
     return Refutation(tuple(_multiplier(m) for m in data["multipliers"]),
-                      _square(data["rest"]), Fraction(data.get("constant", "0")))
+                      _square(data["rest"]), Fraction(data.get("constant", "0")), products)
 
 
 def _multiplier_json(multiplier: Multiplier):
