@@ -2,9 +2,12 @@
 satisfy the query exactly, it finds slivers that uniform samples miss, it returns
 nothing for an unsatisfiable query, and the loop's trigger (first for many states or
 after a slow query; after an UNKNOWN) behaves as documented."""
+import time
 from fractions import Fraction
 
-from fossil_dsl.engine.falsify import FIRST_FROM_STATES, SLOW_QUERY, SOLVER, Falsifier, witness
+from fossil_dsl.engine import falsify
+from fossil_dsl.engine.falsify import (FIRST_FROM_STATES, FIRST_SLICE, SLOW_QUERY, SOLVER,
+                                       Falsifier, witness)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.solvers.api import Answer, Status
@@ -65,21 +68,58 @@ def test_undefined_values_are_far_not_witnesses():
     assert point is not None and 0 < point[0] <= 0.3679
 
 
+class _Verifier:
+    """A stand-in verifier: records the budgets it is given; answers `answer`, after
+    using up the budget where `slow`."""
+
+    def __init__(self, answer, slow=False):
+        self.answer, self.slow, self.budgets = answer, slow, []
+
+    def __call__(self, seconds):
+        self.budgets.append(seconds)
+        if self.slow:
+            time.sleep(seconds)
+        return self.answer
+
+
 def test_the_falsifier_searches_first_only_where_bisection_is_slow():
     two = ["x", "y"]
     query = L.conjunction(_in_box(two, -1, 1), L.Compare(">=", _var("x"), E.Num(Fraction(1, 2))))
     falsifier = Falsifier(two, ([-1, -1], [1, 1]), seed=0)
-    assert falsifier.first("decrease", query) is None  # two states, never slow yet
     proved = Answer(Status.UNSAT)
+    verifier = _Verifier(proved)
+    assert falsifier.checked("decrease", query, 60, verifier) is proved  # two states, never slow
+    assert verifier.budgets == [min(60, FIRST_SLICE)]
     assert falsifier.after("decrease", query, proved, SLOW_QUERY + 1) is proved
-    found = falsifier.first("decrease", query)  # slow once: searched first from now on
-    assert found.status is Status.SAT and found.solver == SOLVER
+    found = falsifier.checked("decrease", query, 60, verifier)  # slow once: searched first
+    assert found.status is Status.SAT and found.solver == SOLVER and len(verifier.budgets) == 1
     assert _exactly_true(query, two, [found.model[s] for s in two])
     assert FIRST_FROM_STATES <= 6
-    assert Falsifier(SIX, ([-2] * 6, [2] * 6), 0).first("boundary", _shell_sliver()) is not None
+    six = _Verifier(proved)
+    assert Falsifier(SIX, ([-2] * 6, [2] * 6), 0).checked(
+        "boundary", _shell_sliver(), 60, six).status is Status.SAT and six.budgets == []
     # with Z3 (complete on polynomials, quick to find points) only after a slow query
-    assert Falsifier(SIX, ([-2] * 6, [2] * 6), 0, bisecting=False).first(
-        "boundary", _shell_sliver()) is None
+    assert Falsifier(SIX, ([-2] * 6, [2] * 6), 0, bisecting=False).checked(
+        "boundary", _shell_sliver(), 60, six) is proved
+
+
+def test_a_verifier_without_an_answer_in_its_first_slice_is_searched_then_asked_again(
+        monkeypatch):
+    monkeypatch.setattr(falsify, "FIRST_SLICE", 0.2)
+    two = ["x", "y"]
+    unknown = Answer(Status.UNKNOWN, reason="timeout")
+    failing = L.conjunction(_in_box(two, -1, 1), L.Compare(">=", _var("y"), E.Num(Fraction(9, 10))))
+    verifier = _Verifier(unknown, slow=True)
+    found = Falsifier(two, ([-1, -1], [1, 1]), seed=0).checked("decrease", failing, 3, verifier)
+    assert found.status is Status.SAT and verifier.budgets == [0.2]  # not asked again
+    impossible = L.conjunction(_in_box(two, -1, 1), L.Compare(">=", _var("y"), E.Num(2)))
+    verifier = _Verifier(unknown, slow=True)
+    assert Falsifier(two, ([-1, -1], [1, 1]), seed=0).checked(
+        "decrease", impossible, 3, verifier) is unknown
+    assert verifier.budgets[0] == 0.2 and 1 < verifier.budgets[1] < 2.8  # the rest
+    quick = _Verifier(unknown)  # an UNKNOWN before the slice ends: not asked again
+    Falsifier(two, ([-1, -1], [1, 1]), seed=0).checked("decrease", impossible, 3, quick)
+    assert quick.budgets == [0.2]
 
 
 def test_an_unknown_answer_becomes_a_counterexample_where_one_is_found():

@@ -10,6 +10,8 @@ here proves anything: the point is a lead for the learner, as a delta-sat box's 
 """
 from __future__ import annotations
 
+import time
+
 from fossil_dsl.engine.evaluate import holds, state_env
 from fossil_dsl.ir import logic as L
 from fossil_dsl.solvers.api import Answer, Status
@@ -26,6 +28,11 @@ SLOW_QUERY = 5.0  # seconds: a condition whose query took longer is searched fir
 # counterexamples (x12's boundary condition: 27 s); Z3 finds them at once on polynomial
 # problems, where the search only cost time (row04, 8 states: 0.1 -> 0.8 s of verifying)
 FIRST_FROM_STATES = 5
+# a verifier not searched before gets this long first; with no answer by then, the
+# search runs, then the verifier again with the time left (probe44/y06: Z3, CVC5 and the
+# interval procedure left a failing decrease unanswered for the query's whole 60 s, and
+# the search found a point in a second once they had)
+FIRST_SLICE = 10.0
 SOLVER = "numeric search"
 
 
@@ -39,9 +46,22 @@ class Falsifier:
         self.always_first = bisecting and len(self.states) >= FIRST_FROM_STATES
         self.slow: set[str] = set()
 
-    def first(self, name: str, query: L.Formula) -> Answer | None:
-        early = self.always_first or name in self.slow
-        return self.search(query) if early else None
+    def checked(self, name: str, query: L.Formula, budget: float, check) -> Answer:
+        """The answer for the condition's query: searched before or after `check(seconds)`
+        (the verifier), as the class says; a verifier that has not answered within
+        FIRST_SLICE seconds is asked again, with the rest of the budget, if the search
+        finds nothing."""
+        if self.always_first or name in self.slow:
+            return self.search(query) or check(budget)
+        started = time.monotonic()
+        given = min(budget, FIRST_SLICE)
+        answer = check(given)
+        seconds = time.monotonic() - started
+        answer = self.after(name, query, answer, seconds)
+        left = budget - (time.monotonic() - started)
+        if answer.status is Status.UNKNOWN and given < budget and seconds >= given and left > 1:
+            return check(left)
+        return answer
 
     def after(self, name: str, query: L.Formula, answer: Answer, seconds: float) -> Answer:
         if seconds > SLOW_QUERY:

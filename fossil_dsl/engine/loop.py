@@ -279,14 +279,11 @@ class Cegis:
         return tuple(verdicts), queries, time.monotonic() - started
 
     def _checked(self, name: str, query: L.Formula, budget: float) -> Answer:
+        def check(seconds: float) -> Answer:
+            return self.backend.check(query, self.states, seconds)
         if self.falsifier is None:
-            return self.backend.check(query, self.states, budget)
-        found = self.falsifier.first(name, query)
-        if found is not None:
-            return found
-        started = time.monotonic()
-        answer = self.backend.check(query, self.states, budget)
-        return self.falsifier.after(name, query, answer, time.monotonic() - started)
+            return check(budget)
+        return self.falsifier.checked(name, query, budget, check)
 
     def learn_from(self, verdicts) -> None:
         for verdict in verdicts:
