@@ -59,6 +59,7 @@ class Falsifier:
         seconds = time.monotonic() - started
         answer = self.after(name, query, answer, seconds)
         left = budget - (time.monotonic() - started)
+        # only a verifier stopped by the slice (not one that gave up) is worth asking again
         if answer.status is Status.UNKNOWN and given < budget and seconds >= given and left > 1:
             return check(left)
         return answer

@@ -171,9 +171,10 @@ def _gram_entries(n: int, degree: int) -> int:
 
 
 class _RefutationProgram(Program):
-    """s0 + sum_j sigma_j h_j = 0: sigma_j SOS for non-strict h_j >= 0, constants
-    c_k >= 0 for strict h_k > 0 with sum c_k = 1; s0 = m^T (Q + tI) m with Q >= 0, and
-    t (at most 1) as large as possible, so that s0's Gram matrix survives rounding."""
+    """s0 + sum_j sigma_j h_j + sum_(i,k) sigma_ik h_i h_k = 0: sigma_j SOS for non-strict
+    h_j >= 0, constants c_k >= 0 for strict h_k > 0 with sum c_k = 1, sigma_ik SOS for
+    the `pairs`; s0 = m^T (Q + tI) m with Q >= 0, and t (at most 1) as large as possible,
+    so that s0's Gram matrix survives rounding."""
 
     def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int, power: int,
                  pairs: list[tuple[int, int]] = ()):
