@@ -26,7 +26,7 @@ from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
 from fossil_dsl.solvers.sdp import Program
-from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
+from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal, opposite_pairs
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.plan.certificates.roa import ROA_FORMS
 
@@ -145,10 +145,8 @@ def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:
     degree cannot see that it is bounded: the reach program for lit17's sets, and the
     Lyapunov program for a 4-state cubic map (whose V(f(x)) - V(x) has terms -x_i^6 that
     only (1 - x_i^2) times a quartic can match), are infeasible."""
-    linear = [g for g in constraints if P.degree(g) == 1]
-    products = [P.multiply(g, h) for i, g in enumerate(linear) for h in linear[i + 1:]
-                if P.degree(P.add(g, h)) < 1]
-    return constraints + products
+    return constraints + [P.multiply(constraints[i], constraints[k])
+                          for i, k in opposite_pairs(constraints)]
 
 
 class _LyapunovProgram(Program):

@@ -136,16 +136,23 @@ def _variants(powers, pairs):
 
 
 def opposite_bounds(atoms) -> list[tuple[int, int]] | None:
-    """The pairs of non-strict linear comparisons that bound one expression from both
-    sides (l <= x_i and x_i <= u: their product (x_i - l)(u - x_i) >= 0). Without these
-    products a box's multipliers of low degree cannot see that it is bounded: a degree-4
-    V for a 4-state cubic system (probe44/y02), found by a program with them, had no
-    refutation of its decrease without them (6 programs, 4.5 s); with them the first
-    program (a third larger) is one. None where there are none."""
-    linear = [i for i, (h, strict) in enumerate(atoms) if not strict and P.degree(h) == 1]
-    pairs = [(i, k) for a, i in enumerate(linear) for k in linear[a + 1:]
-             if P.degree(P.add(atoms[i][0], atoms[k][0])) < 1]
+    """The pairs of non-strict comparisons among `opposite_pairs`, or None where there
+    are none. Without their products a box's multipliers of low degree cannot see that
+    it is bounded: a degree-4 V for a 4-state cubic system (probe44/y02), found by a
+    program with them, had no refutation of its decrease without them (6 programs,
+    4.5 s); with them the first program (a third larger) is one."""
+    pairs = [(i, k) for i, k in opposite_pairs([h for h, _ in atoms])
+             if not atoms[i][1] and not atoms[k][1]]
     return pairs or None
+
+
+def opposite_pairs(polynomials) -> list[tuple[int, int]]:
+    """The index pairs of linear polynomials that bound one expression from both sides
+    (l <= x_i and x_i <= u as x_i - l >= 0 and u - x_i >= 0: their sum is a constant, and
+    their product (x_i - l)(u - x_i) >= 0)."""
+    linear = [i for i, h in enumerate(polynomials) if P.degree(h) == 1]
+    return [(i, k) for a, i in enumerate(linear) for k in linear[a + 1:]
+            if P.degree(P.add(polynomials[i], polynomials[k])) < 1]
 
 
 def _least_abstracted_size(query: L.Formula, states) -> int:
