@@ -175,3 +175,21 @@ prove from init: stable
     result = fossil_dsl.synthesise(spec, timeout=60)
     assert result.certified, result.summary()
     assert result.iterations == 1  # the seed itself
+
+
+# probe45/z09: three carts joined by springs, a force on the last
+THREE_CARTS = (Path(__file__).resolve().parent.parent
+               / "specs/probe45/z09_three_carts_stab_ctrl_6d.fsl").read_text()
+
+
+def test_an_lqr_seed_whose_ellipsoids_cannot_fit_between_i_and_d_is_not_preferred():
+    """The identity weights' V met every condition on the samples, but its sublevel sets
+    that hold I cross D's faces where no sample lies; the run learned from it for 120 s
+    and was not certified. The ellipsoid seed fits, and is certified at once."""
+    spec = fossil_dsl.loads(THREE_CARTS)
+    P_lqr, _ = local_certificate(spec, True, np.zeros(1))
+    inside = np.linalg.eigvalsh(P_lqr).max() * 0.2 ** 2  # the largest V on the ball I
+    assert (np.diag(np.linalg.inv(P_lqr)) * inside).max() > 1  # some face is inside
+    result = fossil_dsl.synthesise(spec, timeout=60)
+    assert result.certified, result.summary()
+    assert result.iterations == 1

@@ -7,7 +7,7 @@ import pytest
 import sympy
 
 import fossil_dsl
-from fossil_dsl.engine import sos
+from fossil_dsl.engine import sos, sos_barrier
 from fossil_dsl.plan.compile import compile_spec
 
 # Khalil's Example 4.? style: a polynomial system with a cubic coupling, 3 states
@@ -327,3 +327,36 @@ def test_a_quartic_v_found_with_box_products_is_refuted_with_them_too():
     decrease = next(p for p in result.kernel.proofs
                     if p.obligation.name == "condition:decrease")
     assert decrease.proved and getattr(decrease.evidence, "products", ())
+
+
+# probe45/z03: the SIR model, where every point with i = 0 is an equilibrium; no quadratic
+# B meets the program's conditions, learning failed in 25 iterations
+EPIDEMIC = """\
+state s, i
+dynamics continuous {
+    s' = -s*i
+    i' = s*i - 0.5*i
+}
+domain box([0, 0], [1, 1])
+set init = box([0.3, 0.01], [0.45, 0.05])
+set unsafe = { i >= 0.2 }
+prove from init: always not unsafe
+"""
+
+
+def test_a_barrier_no_quadratic_can_be_is_found_quartic_where_the_program_is_small(
+        monkeypatch):
+    with monkeypatch.context() as patch:
+        patch.setattr(sos_barrier, "DEGREES", (1,))
+        assert sos_barrier.barrier(_plan(EPIDEMIC), time.monotonic() + 30) is None
+    result = fossil_dsl.synthesise(fossil_dsl.loads(EPIDEMIC), timeout=60)
+    assert result.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 4")
+
+
+def test_a_quartic_barrier_is_not_tried_where_its_program_is_large():
+    """bb25 (6 states): the quartic program has 1 877 variables, and its B took the
+    solvers longer than learning does."""
+    text = (Path(__file__).resolve().parent.parent / "specs/barrierbench/bb25.fsl").read_text()
+    plan = _plan(text)
+    assert sos_barrier.barrier(plan, time.monotonic() + 30) is None

@@ -25,10 +25,14 @@ from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.plan.compile import Plan
 
-# B of degree 2 only: a quartic B's initial condition often has no refutation whose Gram
-# matrix survives rounding (no interior: bb25), and the solvers then take longer than
-# learning does (37 s against 6 s)
-DEGREES = (1,)
+# B of degree 2 first, then 4 only where that program is small: a quartic B's initial
+# condition often has no refutation whose Gram matrix survives rounding (no interior:
+# bb25, 6 states, 1 877 variables), and the solvers then take longer than learning does
+# (37 s against 6 s); with 2 states (z03, an SIR model whose quadratic programs are
+# infeasible) the quartic program of 251 variables is solved and refuted at once, where
+# learning failed in 25 iterations
+DEGREES = (1, 2)
+HIGHER_DEGREE_MAX_VARIABLES = 1000
 DECAY_RATES = (1.0, 0.1, 10.0)  # mu, in the order tried
 DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 
@@ -46,7 +50,7 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
             if time.monotonic() > deadline:
                 return None
             program = BarrierProgram(len(states), field, initial, [unsafe], domain, degree, mu)
-            if program.count > MAX_VARIABLES:
+            if program.count > (MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES):
                 return None
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
             if x is None or x[program.margin] <= MIN_MARGIN:

@@ -12,7 +12,7 @@ from fossil_dsl.engine.ellipsoid_seed import ellipsoid
 from fossil_dsl.engine.linear import (STABLE_FORMS, holds_a_quadratic, is_linear, jacobians,
                                       lyapunov_matrix, separation, set_linear, set_quadratic)
 from fossil_dsl.engine.networks import Network
-from fossil_dsl.engine.quadratic_shapes import lqr_gains
+from fossil_dsl.engine.quadratic_shapes import boundary_floor, lqr_gains, set_ceiling
 from fossil_dsl.ir.spec import TimeDomain
 
 
@@ -45,16 +45,30 @@ def _seeds(plan, networks, controller, samples):
     rng = np.random.default_rng(plan.options.seed)
     gains = lqr_gains(plan.spec, controller is not None, None, rng)
     for A, K in itertools.islice(gains, 1):  # the identity weights
-        yield from _lqr_seed(networks, controller, samples, A, K, discrete)
+        yield from _lqr_seed(plan, networks, controller, samples, A, K, discrete)
     yield from _ellipsoid_seed(plan, networks, controller, samples, discrete)
     for A, K in gains:
-        yield from _lqr_seed(networks, controller, samples, A, K, discrete)
+        yield from _lqr_seed(plan, networks, controller, samples, A, K, discrete)
 
 
-def _lqr_seed(networks, controller, samples, A, K, discrete: bool):
+def _lqr_seed(plan, networks, controller, samples, A, K, discrete: bool):
     P = lyapunov_matrix(A, discrete)
     if P is not None:
-        yield True, _quadratic_setter(networks, controller, samples, P, K)
+        yield _has_room(plan, P), _quadratic_setter(networks, controller, samples, P, K)
+
+
+def _has_room(plan, P: np.ndarray) -> bool:
+    """Whether some sublevel set of x^T P x holds I and lies inside D, where both bounds
+    are worked out (else True: the samples decide). Samples of a box's boundary in 6
+    states miss the directions where an LQR ellipsoid leaves D (z09's three carts: the
+    identity weights' ellipsoid, satisfied on every sample, crossed D's face)."""
+    initial = plan.spec.property.role("initial")
+    if initial is None:
+        return True
+    centre = np.zeros(len(P))
+    ceiling = set_ceiling(P, initial, centre)
+    floor = boundary_floor(P, plan.spec.domain, centre)
+    return ceiling is None or floor is None or ceiling < floor
 
 
 def _ellipsoid_seed(plan, networks, controller, samples, discrete: bool):
