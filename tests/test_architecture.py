@@ -226,3 +226,38 @@ def test_a_verifier_only_run_imports_no_torch(tmp_path):
     assert "torch" not in imported
     assert (tmp_path / "out" / "phase_portrait.png").exists()
     assert not (tmp_path / "out" / "networks.pt").exists()  # nothing was trained
+
+
+@pytest.mark.parametrize("spec", ["specs/probe45/z02_lorenz_subcritical_stable.fsl",
+                                  "specs/probe45/z28_bilinear_reach_4d.fsl"])
+def test_a_run_certified_without_learning_imports_no_torch(spec, tmp_path):
+    """A sum-of-squares Lyapunov function, a sum-of-squares reach certificate: torch and
+    torch._dynamo were 2-3 s of the 4.5 s such a `fossilc` call took."""
+    run, imported = _run_listing_imports([spec, "-o", str(tmp_path / "out")])
+    assert run.returncode == 0, run.stdout + run.stderr[-2000:]
+    assert "CERTIFIED" in run.stdout and "sum-of-squares" in run.stdout
+    assert "torch" not in imported
+
+
+LEARNING_RUN_TIMES = """\
+import time
+import fossil_dsl
+from fossil_dsl.engine import torch_import
+spec = fossil_dsl.load("specs/stability_tanh_network.fsl")
+started = time.monotonic()
+result = fossil_dsl.synthesise(spec, timeout=60)
+print(result.certified, result.total_seconds, torch_import.seconds_spent(),
+      time.monotonic() - started)
+"""
+
+
+def test_a_run_that_learns_leaves_the_torch_import_out_of_its_time():
+    import subprocess
+    import sys
+    run = subprocess.run([sys.executable, "-c", LEARNING_RUN_TIMES], cwd=PACKAGE.parent,
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    certified, total, imported, wall = run.stdout.split()[-4:]
+    assert certified == "True"
+    assert float(imported) > 0.1  # torch was imported in the run, and timed
+    assert float(total) + float(imported) <= float(wall) + 0.01

@@ -9,7 +9,7 @@ import time
 import numpy as np
 from dataclasses import replace
 
-from fossil_dsl.engine import basin, first_integral, sos, sos_reach
+from fossil_dsl.engine import basin, first_integral, sos, sos_reach, torch_import
 from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import (Cegis, CegisOutcome, IterationRecord, Verdict, as_listener,
@@ -67,6 +67,7 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
             return found
         notes.append(note)
     note = "; ".join(n for n in notes if n)
+    deadline += _learning_imported(plan)
     outcome = Cegis(plan, backend, listener, deadline).run()
     variant = _variant_plan(plan) if verifier_only(plan) and not outcome.certified else None
     if variant is not None:  # a given function may meet the variant's conditions instead
@@ -74,6 +75,16 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
         if other.certified:
             return variant, replace(other, strategy="given function")
     return plan, replace(outcome, strategy="learning" + (f" ({note})" if note else ""))
+
+
+def _learning_imported(plan: Plan) -> float:
+    """Seconds spent importing torch for the loop's learning (0 where it learns nothing,
+    or torch was in already): start-up, which the loop's deadline is moved on by."""
+    if verifier_only(plan):
+        return 0.0
+    before = torch_import.seconds_spent()
+    torch_import.learning_support()
+    return torch_import.seconds_spent() - before
 
 
 def _variant_plan(plan: Plan) -> Plan | None:

@@ -35,14 +35,6 @@ TARGET_SURROUNDINGS = 3.0  # the box near a goal: its bounding box scaled by thi
 ADAM_BETAS = (0.9, 0.9)
 
 
-def import_optimiser_support() -> None:
-    """torch's optimisers import torch._dynamo on their first use (about 1.5 s, once per
-    process). Called before a run's clock starts, so that this import counts as start-up,
-    like every other, and not as the first run's learning time; not at module import,
-    so that commands that never train (`fossilc check`) do not pay for it."""
-    import torch._dynamo  # noqa: F401
-
-
 class Learner(ViolationSearch):
     def __init__(self, plan: Plan, generator: torch.Generator):
         self.plan = plan

@@ -13,17 +13,19 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
+from typing import TYPE_CHECKING
 
 import numpy as np
-import torch
 
-from fossil_dsl.engine.networks import Network
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir.calculus import derivative
 from fossil_dsl.ir.enclosure import enclose
 from fossil_dsl.ir.spec import CheckedSpec, TimeDomain
 from fossil_dsl.plan.certificates.roa import ROA_FORMS
+
+if TYPE_CHECKING:  # torch only where a network is set: the linearisation itself is numpy
+    from fossil_dsl.engine.networks import Network
 
 STABLE_FORMS = ("stability", "stable while avoid") + ROA_FORMS
 # where between the largest x^T P x on I and the smallest on U (sampled) the barrier's
@@ -204,7 +206,7 @@ def quadratic_values(P: np.ndarray, points) -> np.ndarray:
 
 
 def as_array(points) -> np.ndarray:
-    return np.asarray(points.detach() if isinstance(points, torch.Tensor) else points,
+    return np.asarray(points.detach() if hasattr(points, "detach") else points,
                       dtype=np.float64)
 
 
@@ -225,6 +227,7 @@ def set_quadratic(network: Network, P: np.ndarray, level: float = 0.0, centre=No
     weight 0. A layer that sees x / d (input divisors) holds L^T d. With a `centre` c
     (the network must have biases), the first layer's biases are -L^T c: V(x) =
     (x - c)^T P (x - c) - level."""
+    import torch
     factor = torch.as_tensor(np.linalg.cholesky(P).T, dtype=torch.float64)
     shift = None if centre is None else -factor @ torch.as_tensor(centre, dtype=torch.float64)
     if network.divisors is not None:
@@ -243,6 +246,7 @@ def set_quadratic(network: Network, P: np.ndarray, level: float = 0.0, centre=No
 def set_linear(network: Network, gain: np.ndarray, offset=None) -> None:
     """k(x) = gain x + offset: the hidden layer holds the gain, the output passes it
     through and adds the offset."""
+    import torch
     m = gain.shape[0]
     with torch.no_grad():
         hidden, output = network.linears[0].weight, network.output.weight
@@ -256,6 +260,7 @@ def set_linear(network: Network, gain: np.ndarray, offset=None) -> None:
 def _set_output_bias(network: Network, values) -> None:
     """Hidden biases 0; the output's first biases `values` (a network without biases
     must not be given non-zero ones)."""
+    import torch
     for layer in (network.linears[0], network.output):
         if layer.bias is not None:
             layer.bias.zero_()

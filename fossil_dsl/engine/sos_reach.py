@@ -27,6 +27,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from fossil_dsl.engine.linear import operating_point
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.engine.sos import Inexact, interval_products, set_constraints
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
@@ -80,7 +81,6 @@ def applies(plan: Plan) -> bool:
 
 def search(plan: Plan, deadline: float) -> ReachFinding | None:
     """The first V (and B) found, over the controllers tried and V's degrees."""
-    from fossil_dsl.engine.linear import operating_point  # imports torch
     started = time.monotonic()
     spec, states = plan.spec, plan.states
     operating = operating_point(spec) if spec.inputs else np.zeros(0)

@@ -14,6 +14,7 @@ from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.attempts import run_attempts
 from fossil_dsl.engine.region import largest_level
 from fossil_dsl.engine.split import SplitBackend
+from fossil_dsl.engine import torch_import
 from fossil_dsl.plan.compile import Plan, compile_spec
 from fossil_dsl.kernel import Verdict, judge, not_certified
 from fossil_dsl.kernel.prove import ATOMS_REFUTATION_FIRST
@@ -41,10 +42,12 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
     queries, in the loop and in the kernel, into pieces checked in parallel."""
     options = check_options(options)  # a bad value raises OptionError before any work
     plan = compile_spec(spec, certificate=certificate, **options)
-    _import_run_libraries(plan)
+    _import_run_libraries()
     started = time.monotonic()
+    imports = torch_import.seconds_spent()
     backend = None if plan.options.learn_only else _backend(plan, pieces)
     plan, outcome = run_attempts(plan, backend, progress)
+    started += torch_import.seconds_spent() - imports  # start-up, not the run's work
     verdict = _judge(plan, outcome, pieces, deadline=started + plan.options.timeout)
     found = None
     if plan.options.largest_region and verdict.certified:
@@ -58,14 +61,12 @@ def synthesise(spec: CheckedSpec, progress=None, certificate=None, pieces=None,
 # before a run's clock starts, so that a run's time is its own work: 0.2-0.4 s of
 # imports had been most of a sub-second run's time (docs/benchmarks.md, session 41).
 # codac is not among them: it is imported by import_codac(), which keeps the rounding
-# mode that codac's import changes.
+# mode that codac's import changes; nor torch: only runs that learn import it
+# (engine/torch_import.py), and the time that takes is left out of the run's.
 RUN_LIBRARIES = ("scipy.linalg", "scipy.sparse", "clarabel", "cvc5", "z3")
 
 
-def _import_run_libraries(plan: Plan) -> None:
-    if not verifier_only(plan):
-        from fossil_dsl.engine.learner import import_optimiser_support
-        import_optimiser_support()
+def _import_run_libraries() -> None:
     for name in RUN_LIBRARIES:
         if importlib.util.find_spec(name.partition(".")[0]) is not None:
             importlib.import_module(name)
