@@ -289,7 +289,8 @@ def test_violating_samples_are_added_worst_first_and_only_those():
 
 
 def test_a_run_that_brings_no_new_counterexample_is_stalled():
-    from fossil_dsl.engine.loop import STALL_ITERATIONS, IterationRecord, Verdict, _stalled
+    from fossil_dsl.engine.course import STALL_ITERATIONS, stalled as _stalled
+    from fossil_dsl.engine.loop import IterationRecord, Verdict
 
     def record(i, *found):
         verdicts = tuple(Verdict(name, Status.SAT, "", point) for name, point in found)
@@ -304,6 +305,48 @@ def test_a_run_that_brings_no_new_counterexample_is_stalled():
     assert not _stalled([record(i) for i in range(5)])      # nothing failed with SAT
     repeated = [record(i, a) for i in range(STALL_ITERATIONS + 1)]
     assert _stalled(repeated) and not _stalled(repeated[1:])
+
+
+def test_an_unchanged_candidate_left_undecided_is_not_verified_again():
+    from fossil_dsl.engine.course import undecided_again
+    from fossil_dsl.engine.loop import Verdict
+    candidate, other = object(), object()
+    undecided = (Verdict("invariance", Status.UNKNOWN, "timeout"),
+                 Verdict("initial", Status.UNSAT))
+    assert undecided_again((candidate, {}, undecided), candidate)
+    assert not undecided_again((candidate, {}, undecided), other)  # learning changed it
+    assert not undecided_again(None, candidate)
+    failed = undecided + (Verdict("unsafe", Status.SAT, "", (1, 2)),)
+    assert not undecided_again((candidate, {}, failed), candidate)  # a point to learn from
+
+
+class _TimedBackend:
+    """Answers `unsafe` with a counterexample, everything else UNKNOWN, recording the time
+    each query was given."""
+    name = "z3"
+
+    def __init__(self):
+        self.budgets = {}
+
+    def check(self, formula, variables, timeout, stop=None):
+        self.budgets[str(formula)] = timeout
+        if len(self.budgets) == 1:  # the first condition fails at a point
+            return Answer(Status.SAT, {v: 0 for v in variables})
+        return Answer(Status.UNKNOWN, reason="timeout")
+
+
+def test_queries_after_a_failure_in_the_iteration_get_less_time():
+    from fossil_dsl.engine import course
+    from fossil_dsl.engine.loop import Cegis
+    spec = fossil_dsl.load(Path(__file__).resolve().parent.parent / "specs/safety_continuous.fsl")
+    plan = compile_spec(spec, timeout=600, query_timeout=60)
+    backend = _TimedBackend()
+    cegis = Cegis(plan, backend)
+    cegis.falsifier = None  # the backend alone answers
+    verdicts, _, _ = cegis.verify(cegis.exact_candidate())
+    budgets = list(backend.budgets.values())
+    assert verdicts[0].status is Status.SAT and len(budgets) == len(verdicts) >= 3
+    assert budgets[0] == 60 and all(b <= course.AFTER_A_FAILURE for b in budgets[1:])
 
 
 def test_restart_draws_new_weights_and_keeps_the_samples():

@@ -6,11 +6,13 @@ formulas that are returned with it.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from typing import Callable
 
+from fossil_dsl.engine.course import AFTER_A_FAILURE, failed, stalled, undecided_again
 from fossil_dsl.engine.falsify import Falsifier
 from fossil_dsl.engine.given import GivenFunctions, verifier_only
 from fossil_dsl.plan.certificates.base import change_of, level_of, next_value, value_of
@@ -185,6 +187,11 @@ class Cegis:
             self.listener.phase(state.iteration, "learning")
             loss, learn_seconds = self.learn(state)
             candidate = self.exact_candidate()
+            if undecided_again(state.last_verified, candidate):
+                self.learner.restart()
+                restarted = len(state.history)
+                loss, more = self.learn(state)
+                learn_seconds, candidate = learn_seconds + more, self.exact_candidate()
             verdicts, queries, verify_seconds = self.verify(candidate, state.iteration)
             state.verify_seconds += verify_seconds
             state.last_verified = (candidate, queries, verdicts)
@@ -199,7 +206,7 @@ class Cegis:
                 return self.outcome(state, False, failure_reason(verdicts), candidate,
                                     queries, verdicts)
             self.learn_from(verdicts)
-            if _stalled(state.history[restarted:]):  # stuck where it cannot meet them
+            if stalled(state.history[restarted:]):  # stuck where it cannot meet them
                 self.learner.restart()
                 restarted = len(state.history)
             if time.monotonic() > self.deadline:
@@ -273,7 +280,8 @@ class Cegis:
             self.listener.phase(iteration, f"verifying {condition.name} ({number}/{total})")
             query = L.substitute(self.plan.query(condition), mapping)
             queries[condition.name] = query
-            budget = max(1.0, min(self.options.query_timeout, self.deadline - time.monotonic()))
+            budget = max(1.0, min(self.options.query_timeout, self.deadline - time.monotonic(),
+                                  AFTER_A_FAILURE if failed(verdicts) else math.inf))
             answer = _decided(query, self.states) or self._checked(condition.name, query, budget)
             verdicts.append(_verdict(condition.name, answer, self.states, self.backend.name))
         return tuple(verdicts), queries, time.monotonic() - started
@@ -291,29 +299,6 @@ class Cegis:
                 self.learner.add_counterexample(verdict.condition, verdict.counterexample)
             elif verdict.status is Status.UNKNOWN:  # learn something: more samples there
                 self.learner.add_region_samples(verdict.condition)
-
-
-STALL_ITERATIONS = 3  # iterations bringing no new counterexample before a restart
-
-
-def _stalled(history: list[IterationRecord]) -> bool:
-    """Whether each of the last STALL_ITERATIONS iterations failed only with
-    counterexamples met before (since the last restart): the learner cannot meet them
-    from where it is, and more of the same will not help."""
-    if len(history) < STALL_ITERATIONS:
-        return False
-    seen: set = set()
-    repeats = 0
-    for record in history:
-        found = _counterexamples(record)
-        repeats = repeats + 1 if found and found <= seen else 0
-        seen |= found
-    return repeats >= STALL_ITERATIONS
-
-
-def _counterexamples(record: IterationRecord) -> frozenset:
-    return frozenset((v.condition, v.counterexample) for v in record.verdicts
-                     if v.status is Status.SAT)
 
 
 def _decided(query: L.Formula, states) -> Answer | None:
