@@ -10,7 +10,6 @@ from fossil_dsl.frontends.arguments import OptionError, check_options
 from fossil_dsl.frontends.build import BespokeSet, BuildError, build_spec, spec_text
 from fossil_dsl.frontends.checking import (CheckResult, check_file, check_source, check_text,
                                            load, loads, parse)
-from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.attempts import run_attempts
 from fossil_dsl.engine.region import largest_level
 from fossil_dsl.engine.split import SplitBackend
