@@ -20,6 +20,7 @@ from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
+from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.atoms import folded
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.ir.numbers import rational
@@ -254,7 +255,8 @@ class Cegis:
         digits = self.learner.digits
         learner = self.learner
         formulas = {f.name: f.candidate if f.candidate is not None
-                    else learner.networks[f.name].formula(self.states, digits)
+                    else P.compact(learner.networks[f.name].formula(self.states, digits),
+                                   self.states)
                     for f in self.plan.functions}
         controller = {}
         if learner.controller is not None:

@@ -118,7 +118,7 @@ def _backend(plan: Plan, pieces=None):
     over the fallback, it cost the portfolio's reach-type rows 1 to 3 s of verifying).
     Problems with elementary functions get the refutation first (through the queries'
     polynomial form) from ATOMS_REFUTATION_FIRST states on, where bisection slows down."""
-    from fossil_dsl.solvers.sos_refutation import RefutationFirst
+    from fossil_dsl.solvers.refutation_first import RefutationFirst
 
     def load(name: str):
         backend = registry.load(name, plan.options.delta, search=True)

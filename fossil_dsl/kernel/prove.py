@@ -18,14 +18,18 @@
   function application, with facts its value satisfies: solvers/atom_facts.py), which
   goes first from ATOMS_REFUTATION_FIRST states on or where it proved the condition
   during the run. Only UNSAT is used from either; a box the interval procedure cannot
-  refute is "not proved", never a proof.
+  refute is "not proved", never a proof. Where the refutation of the whole query fails
+  and the query leaves out a ball round the origin, the query is proved in two pieces
+  that cover every point: within a ball |x| <= R by a refutation, beyond it by the
+  interval procedure (solvers/ball_split.py).
 
 Whatever a procedure says other than UNSAT (a counterexample, delta-SAT, UNKNOWN, a
 timeout) leaves the obligation unproved.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, replace
 from enum import Enum
 from fractions import Fraction
 from typing import Sequence
@@ -36,6 +40,7 @@ from fossil_dsl.ir.atoms import folded
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
 from fossil_dsl.kernel.obligations import Obligation
+from fossil_dsl.solvers import ball_split
 from fossil_dsl.solvers.positivstellensatz import BEFORE_Z3_FROM, refutation_problem
 from fossil_dsl.solvers.api import Answer, Status
 
@@ -106,6 +111,10 @@ def _transcendental(obligation: Obligation, states, timeout: float, delta, first
         answer = _solver(SUM_OF_SQUARES).check(obligation.query, states, max(1.0, share))
         if answer.status is Status.UNSAT:
             return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES, evidence=answer.evidence)
+        split = _split_at_ball(obligation, states, timeout - share, delta, pieces) \
+            if ball_split.excluded_radius(obligation.query, states) is not None else None
+        if split is not None:
+            return split
     proof = _interval(obligation, states, timeout - share, delta, pieces)
     if proof.proved or refutation_first:
         return proof
@@ -113,6 +122,24 @@ def _transcendental(obligation: Obligation, states, timeout: float, delta, first
     if answer.status is Status.UNSAT:
         return Proof(obligation, Outcome.PROVED, SUM_OF_SQUARES, evidence=answer.evidence)
     return proof
+
+
+def _split_at_ball(obligation: Obligation, states, timeout: float, delta,
+                   pieces) -> Proof | None:
+    """The query refuted within a ball round the origin by a sum-of-squares refutation
+    and beyond it by the interval procedure (solvers/ball_split.py: the two pieces cover
+    every point); None where no ball's refutation is found (nothing else is tried)."""
+    started = time.monotonic()
+    beyond, found = ball_split.split_query(obligation.query, states,
+                                           started + ball_split.SEARCH_SHARE * timeout)
+    if found is None:
+        return None
+    # the piece beyond the ball stays away from the origin: nothing holds there
+    piece = replace(obligation, query=beyond, closure_holds=False)
+    proof = _interval(piece, states, timeout - (time.monotonic() - started), delta, pieces)
+    procedure = f"{SUM_OF_SQUARES} within |x| <= {found.radius}, {proof.procedure} beyond"
+    return replace(proof, obligation=obligation, procedure=procedure,
+                   evidence=replace(found, procedure=proof.procedure) if proof.proved else None)
 
 
 def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str,

@@ -1,5 +1,6 @@
 """What `-o DIR` writes: result.json, certificate.txt, the kernel's obligations as
-SMT-LIB 2 (and the sum-of-squares refutations that proved some, as NAME.sos.json), the
+SMT-LIB 2 (and the sum-of-squares refutations that proved some, as NAME.sos.json, or
+that proved them within a ball round the origin, with its radius, as NAME.split.json), the
 networks' weights (networks.pt) and the proved formulas as ONNX models
 (certificate.onnx, controller.onnx)."""
 from __future__ import annotations
@@ -8,14 +9,15 @@ import json
 from pathlib import Path
 
 from fossil_dsl.kernel.obligations import file_stem
+from fossil_dsl.solvers.ball_split import BallSplit, split_json
 from fossil_dsl.solvers.positivstellensatz import refutation_json
 from fossil_dsl.outputs import onnx_export
 from fossil_dsl.outputs.summary import summary_text
 
 
 # what an earlier result in the same folder may have left that this one does not rewrite
-OWN_FILES = ("obligations/*.smt2", "obligations/*.sos.json", "certificate.onnx",
-             "controller.onnx", "networks.pt")
+OWN_FILES = ("obligations/*.smt2", "obligations/*.sos.json", "obligations/*.split.json",
+             "certificate.onnx", "controller.onnx", "networks.pt")
 
 
 def write_artefacts(result: Result, directory: str | Path) -> Path:
@@ -28,9 +30,14 @@ def write_artefacts(result: Result, directory: str | Path) -> Path:
     (out / "certificate.txt").write_text(summary_text(result) + "\n")
     for name, text in result.obligations.items():
         (out / "obligations" / f"{name}.smt2").write_text(text)
-    for name, refutation in result.refutations.items():
-        data = {"obligation": name, **refutation_json(refutation, result.plan.states)}
-        (out / "obligations" / f"{file_stem(name)}.sos.json").write_text(json.dumps(data) + "\n")
+    for name, evidence in result.refutations.items():
+        states = result.plan.states
+        split = isinstance(evidence, BallSplit)
+        data = {"obligation": name, **(split_json(evidence, states) if split
+                                       else refutation_json(evidence, states))}
+        suffix = "split" if split else "sos"
+        (out / "obligations" / f"{file_stem(name)}.{suffix}.json").write_text(
+            json.dumps(data) + "\n")
     write_onnx(result, out)
     if result.networks:
         import torch

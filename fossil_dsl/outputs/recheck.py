@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from pathlib import Path
 
@@ -24,6 +24,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel import Claim, NoRule, list_obligations
 from fossil_dsl.kernel.export import script
 from fossil_dsl.kernel.obligations import file_stem
+from fossil_dsl.solvers.ball_split import pieces, split_from_json
 from fossil_dsl.solvers.positivstellensatz import refutation_from_json, refutation_problem
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES, bisection_first
 from fossil_dsl.solvers import registry
@@ -45,7 +46,10 @@ POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "arb", "dreal")
 # Arb's ball arithmetic (solvers/arb_backend.py) is the other procedure for a
 # transcendental query the interval verifier proved: CVC5 left four BarrierBench flow
 # conditions with sin and cos UNKNOWN at 60 s, which Arb refutes in 0.7 to 9 s.
-TRANSCENDENTAL_ORDER = ("dreal", "interval", "arb", "cvc5")
+# A refutation of the polynomial form goes before Arb: it settles at once what Arb's
+# bisection, which has no contraction, needs boxes for (the part of a 4-state decrease
+# condition beyond a ball, where V <= β and |x| >= R meet in no point: 39 s by Arb).
+TRANSCENDENTAL_ORDER = ("dreal", "interval", SUM_OF_SQUARES, "arb", "cvc5")
 # division and abs: decided by the SMT solvers (a delta-decision procedure cannot refute
 # the boxes round the origin where a rational V's decrease vanishes)
 ARITHMETIC_ORDER = ("cvc5", "z3", "interval", "arb", "dreal")
@@ -79,7 +83,7 @@ def recheck(directory: str | Path, timeout: float = 60.0,
     if not data.get("spec", {}).get("text"):
         return _from_files(folder, used, timeout, solver)
     spec, derived = _derive(data)
-    refutations = read_refutations(folder)
+    refutations, splits = read_refutations(folder), read_splits(folder)
     checks = []
     for obligation in derived:
         stem = obligation.file_stem
@@ -91,20 +95,48 @@ def recheck(directory: str | Path, timeout: float = 60.0,
                 and not solver:
             checks.append(_refutation_checked(stem, obligation, refutations[obligation.name],
                                               spec.states, used.get(stem, "")))
+        elif obligation.name in splits and not solver:
+            checks.append(_split_checked(stem, obligation, splits[obligation.name],
+                                         spec.states, used.get(stem, ""), timeout))
         else:
             checks.append(_decide(stem, obligation.query, spec.states, used.get(stem, ""),
                                   timeout, solver))
     return checks
 
 
+def read_splits(folder: Path) -> dict:
+    """obligation name -> its split at a ball (solvers/ball_split.py), from
+    obligations/*.split.json (unreadable files are left out, as for refutations)."""
+    return _read_evidence(folder, "split", split_from_json)
+
+
+def _split_checked(stem: str, obligation, split, states, used: str, timeout: float) -> Recheck:
+    """The refutation within the ball checked again exactly against the piece derived
+    afresh, and the piece beyond it decided by a procedure other than the run's there."""
+    started = time.monotonic()
+    within, beyond = pieces(obligation.query, states, split.radius)
+    where = f"within |x| <= {split.radius}"
+    problem = refutation_problem(split.inner, within, states)
+    if problem is not None:
+        return Recheck(stem, used, f"{SUM_OF_SQUARES} from {stem}.split.json", "unknown",
+                       f"{where}: {problem}", time.monotonic() - started)
+    check = _decide(stem, beyond, states, split.procedure, timeout, None)
+    return replace(check, proved_by=used, solver=f"{SUM_OF_SQUARES} from {stem}.split.json "
+                   f"{where}, {check.solver} beyond", seconds=time.monotonic() - started)
+
+
 def read_refutations(folder: Path) -> dict:
     """obligation name -> refutation, from obligations/*.sos.json (unreadable files are
     left out: the obligation is then decided by a solver)."""
+    return _read_evidence(folder, "sos", refutation_from_json)
+
+
+def _read_evidence(folder: Path, kind: str, reader) -> dict:
     found = {}
-    for path in sorted((folder / "obligations").glob("*.sos.json")):
+    for path in sorted((folder / "obligations").glob(f"*.{kind}.json")):
         try:
             data = json.loads(path.read_text())
-            found[data["obligation"]] = refutation_from_json(data)
+            found[data["obligation"]] = reader(data)
         except (OSError, ValueError, KeyError, TypeError):
             continue
     return found

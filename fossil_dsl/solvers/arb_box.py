@@ -54,21 +54,40 @@ def _conjuncts(formula: L.Formula) -> list[L.Formula]:
 def _bounds(atom: L.Formula, names):
     """(variable, lower, upper) that the comparison implies: from `x <= c`, `c <= x`, and
     an axis-parallel ellipsoid `sum a_i (x_i - c_i)^2 <= r`."""
+    polynomial = _at_most_zero(atom, names)
+    return [] if polynomial is None else _ellipsoid_bounds(polynomial, names)
+
+
+def _at_most_zero(atom: L.Formula, names) -> dict | None:
+    """p with the comparison saying p(x) <= 0 (or < 0), if p is a polynomial in names."""
     if not isinstance(atom, L.Compare) or atom.relation not in BELOW + ABOVE:
-        return []
+        return None
     small, large = (atom.left, atom.right) if atom.relation in BELOW \
         else (atom.right, atom.left)
     try:
-        polynomial = P.polynomial(E.add(small, E.neg(large)), names)  # <= 0
+        return P.polynomial(E.add(small, E.neg(large)), names)
     except ValueError:
-        return []
-    return _ellipsoid_bounds(polynomial, names)
+        return None
 
 
-def _ellipsoid_bounds(polynomial: dict, names):
-    """For p(x) <= 0 with p = sum (a_i x_i^2 + b_i x_i) + k, every a_i >= 0 (no products
-    of two variables): |x_i + b_i / 2a_i| <= sqrt(R / a_i), R = sum b_i^2 / 4a_i - k,
-    where a_i > 0; x_i <= -k / b_i (or >=) where p is linear in x_i alone."""
+def ellipsoids(formula: L.Formula, names) -> list[tuple[dict, dict, Fraction]]:
+    """The axis-parallel ellipsoids sum a_i (x_i - c_i)^2 <= R among the conjuncts, as
+    ({name: a_i}, {name: c_i}, R), exactly."""
+    found = []
+    for atom in _conjuncts(formula):
+        polynomial = _at_most_zero(atom, names)
+        parts = None if polynomial is None else _ellipsoid_parts(polynomial, names)
+        if parts is not None and parts[0] and _radius(*parts) >= 0:
+            square, linear, _ = parts
+            found.append(({names[i]: a for i, a in square.items()},
+                          {names[i]: -linear.get(i, 0) / (2 * a) for i, a in square.items()},
+                          _radius(*parts)))
+    return found
+
+
+def _ellipsoid_parts(polynomial: dict, names):
+    """({i: a_i}, {i: b_i}, k) for p = sum (a_i x_i^2 + b_i x_i) + k with every a_i > 0
+    and b_i = 0 where a_i is not given (unless p is linear); None for any other p."""
     n = len(names)
     square, linear, constant = {}, {}, Fraction(0)
     for monomial, coefficient in polynomial.items():
@@ -79,29 +98,43 @@ def _ellipsoid_bounds(polynomial: dict, names):
             i = max(range(n), key=lambda j: monomial[j])
             (square if degree == 2 else linear)[i] = Fraction(coefficient)
         else:
-            return []
-    if any(a <= 0 for a in square.values()):
+            return None
+    if any(a <= 0 for a in square.values()) or (square and set(linear) - set(square)):
+        return None
+    return square, linear, constant
+
+
+def _radius(square: dict, linear: dict, constant: Fraction) -> Fraction:
+    """R with p(x) <= 0 the ellipsoid sum a_i (x_i - c_i)^2 <= R."""
+    return sum(linear.get(i, 0) ** 2 / (4 * a) for i, a in square.items()) - constant
+
+
+def _ellipsoid_bounds(polynomial: dict, names):
+    """For p(x) <= 0 with p = sum (a_i x_i^2 + b_i x_i) + k, every a_i >= 0 (no products
+    of two variables): |x_i + b_i / 2a_i| <= sqrt(R / a_i), R = sum b_i^2 / 4a_i - k,
+    where a_i > 0; x_i <= -k / b_i (or >=) where p is linear in x_i alone."""
+    parts = _ellipsoid_parts(polynomial, names)
+    if parts is None:
         return []
+    square, linear, constant = parts
     if not square:
         if len(linear) != 1:
             return []
         (i, b), = linear.items()
         edge = -constant / b
         return [(names[i], -math.inf, _up(edge))] if b > 0 else [(names[i], _down(edge), math.inf)]
-    if set(linear) - set(square):
-        return []
-    radius = sum(linear.get(i, 0) ** 2 / (4 * a) for i, a in square.items()) - constant
+    radius = _radius(square, linear, constant)
     if radius < 0:
         return []
     found = []
     for i, a in square.items():
         centre = -Fraction(linear.get(i, 0)) / (2 * a)
-        reach = Fraction(_sqrt_up(radius / a))
+        reach = Fraction(sqrt_up(radius / a))
         found.append((names[i], _down(centre - reach), _up(centre + reach)))
     return found
 
 
-def _sqrt_up(value: Fraction) -> float:
+def sqrt_up(value: Fraction) -> float:
     root = math.sqrt(_up(value))
     while Fraction(root) ** 2 < value:
         root = math.nextafter(root, math.inf)

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
 from fractions import Fraction
 from typing import Sequence
 
@@ -308,29 +307,3 @@ def _projected(basis, G: np.ndarray, target: P.Polynomial) -> SumOfSquares | Non
                 gram[a][b] += share
     rational = tuple(tuple(row) for row in gram)
     return SumOfSquares(tuple(basis), rational) if positive_semidefinite(rational) else None
-
-
-REFUTATION_SHARE = 0.25  # of a query's time, at most, for the refutation before the solver
-
-
-class RefutationFirst:
-    """A sum-of-squares refutation first, then `backend` with the time left: for
-    polynomial problems, where Z3 stalls on what a small semidefinite program proves at
-    once (an 8-state quadratic's positivity: no answer from Z3 in 50 s). The learning
-    loop puts it before Z3 from BEFORE_Z3_FROM states, else before the fallback's own
-    procedure (frontends/api.py). Counterexamples still come from `backend` alone."""
-
-    def __init__(self, backend):
-        self.backend = backend
-        self.name = f"{SosBackend.name}, then {backend.name}"
-
-    def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
-              stop=None) -> Answer:
-        started = time.monotonic()
-        answer = SosBackend().check(formula, variables, REFUTATION_SHARE * timeout, stop)
-        if answer.status is Status.UNSAT:
-            return answer
-        left = max(0.0, timeout - (time.monotonic() - started))
-        answer = self.backend.check(formula, variables, left, stop)
-        # named after the procedure that answered, which the kernel then tries first
-        return replace(answer, solver=answer.solver or self.backend.name)
