@@ -57,10 +57,11 @@ def pieces(query: L.Formula, states: Sequence[str],
 
 
 def excluded_radius(query: L.Formula, states: Sequence[str]) -> float | None:
-    """r where a conjunct of the query is |x|^2 > r^2 (over all the states), else None."""
+    """r > 0 where a conjunct of the query is |x|^2 > r^2 (over all the states), else None
+    (a query that leaves out the origin alone goes to solvers that decide x != 0)."""
     for conjunct in conjuncts(query):
         if isinstance(conjunct, L.Compare) and conjunct.relation == ">" \
-                and isinstance(conjunct.right, E.Num) and conjunct.right.value >= 0 \
+                and isinstance(conjunct.right, E.Num) and conjunct.right.value > 0 \
                 and _is_squared_norm(conjunct.left, states):
             return math.sqrt(conjunct.right.value)
     return None
