@@ -297,7 +297,8 @@ class Cegis:
 
     def learn_from(self, verdicts) -> None:
         for verdict in verdicts:
-            if verdict.status is Status.SAT:
+            # an undecided query may come with a lead: a point where it was not refuted
+            if verdict.status is not Status.UNSAT and verdict.counterexample is not None:
                 self.learner.add_counterexample(verdict.condition, verdict.counterexample)
             elif verdict.status is Status.UNKNOWN:  # learn something: more samples there
                 self.learner.add_region_samples(verdict.condition)
@@ -323,4 +324,5 @@ def failure_reason(verdicts) -> str:
     failed = [v for v in verdicts if v.status is not Status.UNSAT]
     words = [f"{v.condition}: {'counterexample' if v.status is Status.SAT else v.reason or 'unknown'}"
              for v in failed]
-    return "the given function fails: " + "; ".join(words)
+    verb = "fails" if any(v.status is Status.SAT for v in failed) else "is not proved"
+    return f"the given function {verb}: " + "; ".join(words)

@@ -44,6 +44,67 @@ def polynomial(expr: E.Expr, states: Sequence[str]) -> Polynomial:
     raise NotPolynomial(f"`{expr}` is not a polynomial in the states")
 
 
+def numerator(expr: E.Expr, states: Sequence[str]) -> Polynomial:
+    """N where `expr` = N / D with D a polynomial that is evidently positive (see
+    `over_positive`), so that expr >= 0 exactly where N >= 0 (and > 0 where N > 0): the
+    polynomial form of a comparison with divisions such as y / (1 + z^2). Raises
+    NotPolynomial where no such form is found."""
+    try:
+        return polynomial(expr, states)
+    except NotPolynomial:
+        return over_positive(expr, states)[0]
+
+
+def over_positive(expr: E.Expr, states: Sequence[str]) -> tuple[Polynomial, Polynomial]:
+    """(N, D) with expr = N / D, where D is evidently positive: a positive constant plus
+    positive multiples of monomials with even exponents only, so D >= its constant > 0
+    at every point (such D are closed under products). Raises NotPolynomial where a
+    divisor is not of that kind."""
+    n = len(states)
+    if isinstance(expr, E.Add):
+        parts = [over_positive(t, states) for t in expr.terms]
+        top, bottom = parts[0]
+        for n2, d2 in parts[1:]:
+            top, bottom = (add(top, n2), bottom) if d2 == bottom else \
+                (add(multiply(top, d2), multiply(n2, bottom)), multiply(bottom, d2))
+        return top, bottom
+    if isinstance(expr, E.Mul):
+        top, bottom = constant(1, n), constant(1, n)
+        for factor in expr.factors:
+            n2, d2 = over_positive(factor, states)
+            top, bottom = multiply(top, n2), multiply(bottom, d2)
+        return top, bottom
+    if isinstance(expr, E.Neg):
+        top, bottom = over_positive(expr.operand, states)
+        return scale(top, -1), bottom
+    if isinstance(expr, E.Div):
+        top, bottom = over_positive(expr.numerator, states)
+        return _divided((top, bottom), over_positive(expr.denominator, states))
+    if isinstance(expr, E.Pow) and isinstance(expr.exponent, E.Num) \
+            and expr.exponent.value.denominator == 1:
+        k = int(expr.exponent.value)
+        top, bottom = over_positive(expr.base, states)
+        if k < 0:
+            top, bottom = _divided((constant(1, n), constant(1, n)), (top, bottom))
+        return power(top, abs(k), n), power(bottom, abs(k), n)
+    return polynomial(expr, states), constant(1, n)
+
+
+def _divided(a: tuple[Polynomial, Polynomial],
+             b: tuple[Polynomial, Polynomial]) -> tuple[Polynomial, Polynomial]:
+    """a / b, where b's numerator is evidently positive."""
+    if not evidently_positive(b[0]):
+        raise NotPolynomial("a divisor that is not evidently positive")
+    return multiply(a[0], b[1]), multiply(a[1], b[0])
+
+
+def evidently_positive(p: Mapping[Monomial, Fraction]) -> bool:
+    """p = c + sum of a_m m(x) with c > 0, every a_m > 0 and every m a product of even
+    powers: then p(x) >= c > 0 for every x."""
+    return p.get(tuple(0 for _ in next(iter(p), ())), 0) > 0 and all(
+        c > 0 and all(k % 2 == 0 for k in m) for m, c in p.items())
+
+
 def constant(value, n: int) -> Polynomial:
     value = Fraction(value)
     return {(0,) * n: value} if value else {}

@@ -26,10 +26,13 @@ def summary_text(result: Result) -> str:
         if report.status == "unsat" and report.solver != plan.verifier:
             mark += f" by {report.solver}"
         extra = ""
-        if report.counterexample:
-            extra = " at (" + ", ".join(format(float(v), ".6g") for v in report.counterexample) + ")"
-        elif report.reason:
-            extra = f" ({report.reason})"
+        point = ", ".join(format(float(v), ".6g") for v in report.counterexample or ())
+        if report.status == "sat" and point:
+            extra = f" at ({point})"
+        elif report.reason:  # undecided: a point that came with it is no counterexample
+            extra = f" ({report.reason}" + (f"; last point looked at: ({point}))" if point else ")")
+        elif point:
+            extra = f" (at ({point}))"
         lines.append(f"  [{mark}] {report.text}{extra}")
     lines += kernel_lines(result.kernel)
     if result.learn_only:

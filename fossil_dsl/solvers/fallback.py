@@ -14,7 +14,9 @@ near the origin, where a decrease V(f(x)) - V(x) < 0 is of order |x|^2, the inte
 procedure's boxes of width 1e-4 are never refuted, and such points won the race every
 iteration (probe43/x06: 20 iterations, each learning from a point at 1e-4 of the origin,
 before CVC5 proved the condition in 4 s). After one, the other solver is waited for (at
-most SPURIOUS_WAIT seconds); the point is returned only if it gives no answer either.
+most SPURIOUS_WAIT seconds). If it gives no answer either, the answer is UNKNOWN: the
+query is undecided, and the point, which is no counterexample, comes with it only as a
+lead for the learner.
 
 CEGIS asks the same condition again after each learning step, with new weights. Once the
 second solver has won on a query of some form, later queries of that form (the same
@@ -114,10 +116,10 @@ def _outcome(leader, follower, answers, formula) -> tuple[Answer, Backend | None
         return replace(follow, reason=f"{leader.name} had not answered "
                        f"({lead.reason}); {follow.reason or 'decided'} by {follower.name}"), \
             follower
-    for point in (lead, follow):  # no answer: a point to learn from is still worth having
+    for point in (lead, follow):  # no answer, but a point to learn from is worth having
         if point is not None and point.status is Status.SAT:
-            return replace(point, reason=f"{point.reason} (not a solution when evaluated "
-                           "exactly; neither solver decided)"), None
+            return replace(point, status=Status.UNKNOWN, reason=f"{point.reason} (not a "
+                           "solution when evaluated exactly; neither solver decided)"), None
     reasons = [f"{leader.name}: {lead.reason}"]
     if follow is not None:
         reasons.append(f"{follower.name}: {follow.reason}")

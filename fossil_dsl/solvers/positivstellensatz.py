@@ -117,7 +117,9 @@ def cases(query: L.Formula, index: int) -> list[L.Formula] | None:
 
 def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynomial, bool]]:
     """(h, strict) for each comparison h >= 0 / h > 0 among the query's conjuncts;
-    raises ValueError where one is not polynomial, or where there is none.
+    raises ValueError where one is not polynomial, or where there is none. A side with
+    divisions by evidently positive polynomials (1 + z^2) gives h = N, the numerator of
+    its form N / D over such a D: D > 0 everywhere, so h >= 0 exactly where N >= 0.
 
     Conjuncts that are not comparisons (a disjunction, such as "outside the unsafe box")
     are left out: a refutation of the other conjuncts proves that no point satisfies
@@ -134,7 +136,7 @@ def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynom
             raise ValueError(f"not an inequality: {atom}")
         larger, smaller = (atom.left, atom.right) if atom.relation in (">", ">=") \
             else (atom.right, atom.left)
-        found.append((P.polynomial(add(larger, neg(smaller)), states),
+        found.append((P.numerator(add(larger, neg(smaller)), states),
                       atom.relation in ("<", ">")))
     if not found:
         raise ValueError("the query has no comparison among its conjuncts")
