@@ -64,7 +64,7 @@ def test_a_linear_argument_on_a_ball_gets_the_ball_s_reach():
 
 
 def _outside_origin(query, radius=F(1, 100)):
-    norm = ball_split.squared_norm(STATES)
+    norm = E.squared_norm(STATES)
     return L.conjunction(query, L.Compare(">", norm, E.Num(radius ** 2)), *_box(*STATES))
 
 

@@ -121,3 +121,14 @@ def test_an_undecided_condition_is_not_reported_as_failing():
     assert failure_reason([verdict]).startswith("the given function is not proved")
     failing = Verdict("decrease", Status.SAT, "", (F(1),))
     assert failure_reason([verdict, failing]).startswith("the given function fails")
+
+
+def test_a_division_by_a_negative_number_beside_a_positive_divisor_keeps_its_sign():
+    expr = E.add(E.div(Y, ONE_PLUS_Z2), E.Div(X, E.Num(-2)))  # y/(1 + z^2) - x/2
+    top, bottom = P.over_positive(expr, STATES)
+    assert P.evidently_positive(bottom)
+    for point in [(F(1), F(0), F(0)), (F(0), F(1), F(2)), (F(-3), F(1, 2), F(1))]:
+        x, y, z = point
+        assert _at(top, point) / _at(bottom, point) == y / (1 + z * z) - x / 2
+    with pytest.raises(P.NotPolynomial):  # a divisor that is 0 gives no form
+        P.over_positive(E.add(E.div(Y, ONE_PLUS_Z2), E.Div(X, E.Num(0))), STATES)

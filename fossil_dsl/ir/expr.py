@@ -196,6 +196,11 @@ def mul(*factors: Expr) -> Expr:
     return flat[0] if len(flat) == 1 else Mul(tuple(flat))
 
 
+def squared_norm(names) -> Expr:
+    """x1^2 + ... + xn^2 over the named variables."""
+    return add(*(power(Var(name), Num(2)) for name in names))
+
+
 def neg(operand: Expr) -> Expr:
     if isinstance(operand, Num):
         return Num(-operand.value)

@@ -92,7 +92,9 @@ def over_positive(expr: E.Expr, states: Sequence[str]) -> tuple[Polynomial, Poly
 
 def _divided(a: tuple[Polynomial, Polynomial],
              b: tuple[Polynomial, Polynomial]) -> tuple[Polynomial, Polynomial]:
-    """a / b, where b's numerator is evidently positive."""
+    """a / b, where b's numerator is a nonzero number or evidently positive."""
+    if len(b[0]) == 1 and all(k == 0 for k in next(iter(b[0]))):  # by a number c != 0
+        return scale(multiply(a[0], b[1]), 1 / next(iter(b[0].values()))), a[1]
     if not evidently_positive(b[0]):
         raise NotPolynomial("a divisor that is not evidently positive")
     return multiply(a[0], b[1]), multiply(a[1], b[0])
@@ -101,8 +103,11 @@ def _divided(a: tuple[Polynomial, Polynomial],
 def evidently_positive(p: Mapping[Monomial, Fraction]) -> bool:
     """p = c + sum of a_m m(x) with c > 0, every a_m > 0 and every m a product of even
     powers: then p(x) >= c > 0 for every x."""
-    return p.get(tuple(0 for _ in next(iter(p), ())), 0) > 0 and all(
-        c > 0 and all(k % 2 == 0 for k in m) for m, c in p.items())
+    if not p:
+        return False
+    zero = (0,) * len(next(iter(p)))
+    return p.get(zero, 0) > 0 and all(c > 0 and all(k % 2 == 0 for k in m)
+                                      for m, c in p.items())
 
 
 def constant(value, n: int) -> Polynomial:

@@ -121,7 +121,7 @@ class Facts:
         return E.Num(self.claim.levels[name])
 
     def squared_norm(self) -> E.Expr:
-        return E.add(*(E.power(v, E.Num(2)) for v in self.x))
+        return E.squared_norm(self.states)
 
     def away_from_origin(self) -> L.Formula:
         """x outside the excluded ball (or x != 0)."""

@@ -29,10 +29,10 @@ def summary_text(result: Result) -> str:
         point = ", ".join(format(float(v), ".6g") for v in report.counterexample or ())
         if report.status == "sat" and point:
             extra = f" at ({point})"
-        elif report.reason:  # undecided: a point that came with it is no counterexample
-            extra = f" ({report.reason}" + (f"; last point looked at: ({point}))" if point else ")")
-        elif point:
-            extra = f" (at ({point}))"
+        elif report.reason or point:  # undecided: a point with it is no counterexample
+            notes = [report.reason] if report.reason else []
+            notes += [f"last point looked at: ({point})"] if point else []
+            extra = " (" + "; ".join(notes) + ")"
         lines.append(f"  [{mark}] {report.text}{extra}")
     lines += kernel_lines(result.kernel)
     if result.learn_only:

@@ -44,14 +44,10 @@ class BallSplit:
     procedure: str = ""
 
 
-def squared_norm(states: Sequence[str]) -> E.Expr:
-    return E.add(*(E.power(E.Var(s), E.Num(2)) for s in states))
-
-
 def pieces(query: L.Formula, states: Sequence[str],
            radius: Fraction) -> tuple[L.Formula, L.Formula]:
     """(the query within the ball |x| <= radius, the query outside its interior)."""
-    norm, bound = squared_norm(states), E.Num(radius ** 2)
+    norm, bound = E.squared_norm(states), E.Num(radius ** 2)
     return (L.conjunction(query, L.Compare("<=", norm, bound)),
             L.conjunction(query, L.Compare(">=", norm, bound)))
 

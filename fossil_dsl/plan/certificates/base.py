@@ -92,7 +92,7 @@ class Condition:
         alone) are left out."""
         parts = [self.region.contains_formula(states), self.guard, L.negation(self.claim)]
         if self.exclude_origin:
-            norm = E.add(*(E.power(E.Var(s), E.Num(2)) for s in states))
+            norm = E.squared_norm(states)
             parts.insert(1, L.Compare(">", norm, E.Num(origin_radius ** 2)))
         return L.conjunction(*parts)
 
