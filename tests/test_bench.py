@@ -47,6 +47,9 @@ def test_bench_records_every_run_and_writes_the_tables(tmp_path):
     assert "| broken | 0 | 0 | (error:" in table
     assert "saddle seed 1: not certified (gave up after 2 iterations)" in table
     assert table in run.stdout
+    # stderr is no terminal here: one line per run as it finishes, not a silent bar
+    finished = [line for line in run.stderr.splitlines() if " seed " in line]
+    assert len(finished) == 6 and "saddle seed 1: not certified" in run.stderr
 
 
 def test_table_rows_use_successful_runs_only():

@@ -193,3 +193,19 @@ def test_an_lqr_seed_whose_ellipsoids_cannot_fit_between_i_and_d_is_not_preferre
     result = fossil_dsl.synthesise(spec, timeout=60)
     assert result.certified, result.summary()
     assert result.iterations == 1
+
+
+def test_an_ill_conditioned_seed_is_scaled_to_meet_the_learners_margins():
+    """probe48/c12 (two pendulum maps, one torque): the LQR seed's P, scaled to largest
+    eigenvalue 1, had eigenvalues down to 0.004, under the learner's margin 0.01|x|^2;
+    the learner trained on, and V was indefinite after one step. Scaled, the seed meets
+    the samples, nothing is trained, and it is certified in the first iteration."""
+    path = Path(__file__).resolve().parent.parent / "specs/probe48/c12_coupled_pendulum_maps_one_torque.fsl"
+    plan = compile_spec(fossil_dsl.loads(path.read_text()))
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    assert learner.seeded and learner.loss()[1]  # every condition met on the samples
+    points = torch.rand(2000, 4, dtype=torch.float64) * 0.6 - 0.3
+    values = learner.networks["V"](points)
+    assert (values >= 2 * plan.options.margin * (points ** 2).sum(1)).all()
+    result = fossil_dsl.synthesise(plan.spec, seed=0, timeout=120)
+    assert result.certified and result.iterations == 1, result.summary()

@@ -132,3 +132,17 @@ def test_a_division_by_a_negative_number_beside_a_positive_divisor_keeps_its_sig
         assert _at(top, point) / _at(bottom, point) == y / (1 + z * z) - x / 2
     with pytest.raises(P.NotPolynomial):  # a divisor that is 0 gives no form
         P.over_positive(E.add(E.div(Y, ONE_PLUS_Z2), E.Div(X, E.Num(0))), STATES)
+
+
+def test_a_rational_condition_proved_by_a_solver_is_rechecked_by_a_refutation():
+    """On a loaded machine x06's decrease was proved by a solver in the run, and CVC5,
+    Z3, the interval search and Arb all left it undecided in the re-check."""
+    from fossil_dsl.outputs.recheck import _decide, other_solvers
+    query = _decrease_query(F(1))
+    order = other_solvers("cvc5", query)
+    assert order.index(SUM_OF_SQUARES) < order.index("z3")
+    check = _decide("condition-decrease", query, STATES, "cvc5", 60, None)
+    assert check.status == "unsat" and check.solver == SUM_OF_SQUARES, check
+    # and it never re-proves the expanding map
+    check = _decide("condition-decrease", _decrease_query(F(2)), STATES, "cvc5", 10, None)
+    assert check.status != "unsat", check

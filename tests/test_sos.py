@@ -239,6 +239,26 @@ def test_eight_states_check_and_certify_with_refutations_for_relations_too():
     assert result.kernel.strengthened is not None  # never leaves D: B > 0 on its boundary
 
 
+def test_linear_relations_of_many_states_go_to_z3_first(monkeypatch):
+    """probe48/c11 (7 states, a box domain) was refused as a bad spec on a loaded machine:
+    its linear relations went to the refutation first (1-3 s each, most of it on a
+    satisfiable query) and spent the checker's 5 s. Z3 decides them at once; the
+    refutation still comes first for the nonlinear ones (two balls, above)."""
+    from fossil_dsl.solvers import sos_refutation
+    asked = []
+    original = sos_refutation.SosBackend.check
+
+    def check(self, formula, variables, timeout, stop=None):
+        asked.append(formula)
+        return original(self, formula, variables, timeout, stop)
+    monkeypatch.setattr(sos_refutation.SosBackend, "check", check)
+    path = Path(__file__).resolve().parent.parent / "specs/probe48/c11_hopfield_ring_7d_stable.fsl"
+    checked = fossil_dsl.check_text(path.read_text(), path.name)
+    assert checked.ok, checked.render()
+    assert asked == []
+    assert fossil_dsl.check_text(_ring(8), "ring8.fsl").ok and asked  # balls: refuted first
+
+
 def test_refutations_the_kernel_found_itself_are_exported_and_rechecked(tmp_path):
     from fossil_dsl.outputs.recheck import recheck
     result = fossil_dsl.synthesise(fossil_dsl.check_text(_ring(8), "ring8.fsl").spec,
@@ -354,9 +374,37 @@ def test_a_barrier_no_quadratic_can_be_is_found_quartic_where_the_program_is_sma
     assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 4")
 
 
-def test_a_quartic_barrier_is_not_tried_where_its_program_is_large():
-    """bb25 (6 states): the quartic program has 1 877 variables, and its B took the
-    solvers longer than learning does."""
+def test_a_quartic_barrier_in_six_states_is_tried_and_proved():
+    """bb25 (6 states): its quartic program (1 877 variables) was once left out, since
+    its B took the solvers longer than learning did; its refutations are now found at
+    once. probe48/c09, a non-normal linear system in 6 states, has no quadratic barrier
+    at all (2 465 variables for the quartic)."""
     text = (Path(__file__).resolve().parent.parent / "specs/barrierbench/bb25.fsl").read_text()
-    plan = _plan(text)
-    assert sos_barrier.barrier(plan, time.monotonic() + 30) is None
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=60)
+    assert result.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 4")
+
+
+def test_a_decrease_on_a_tight_sublevel_set_needs_multipliers_of_one_degree_more(monkeypatch):
+    """probe48/c02 (the reversed Van der Pol basin holding the ball of radius 1.3): the
+    degree-6 V shaped to the basin decreases on {V <= 0.93} with a margin of 0.001|x|^2.
+    With s0 of the query's degree (8) no program is feasible; with every multiplier one
+    degree more, the decrease is refuted, and the kernel's check accepts it."""
+    from fractions import Fraction
+    from fossil_dsl.kernel import Claim, list_obligations
+    from fossil_dsl.plan.compile import origin_radius
+    from fossil_dsl.solvers import sos_refutation
+    from fossil_dsl.solvers.positivstellensatz import refutation_problem
+    root = Path(__file__).resolve().parent
+    text = (root.parent / "specs/probe48/c02_reversed_vdp_roa_tight.fsl").read_text()
+    V = (root / "data/c02_shaped_v.txt").read_text().strip()
+    spec = fossil_dsl.loads(text + f"synthesis {{\n    candidate: {V}\n}}\n")
+    plan = _plan(text + f"synthesis {{\n    candidate: {V}\n}}\n")
+    claim = Claim(spec, {"V": plan.functions[0].candidate}, {}, {"beta": Fraction(93, 100)},
+                  origin_radius(spec))
+    [decrease] = [o for o in list_obligations(claim) if o.name == "condition:decrease"]
+    found = sos_refutation.refute(decrease.query, plan.states, time.monotonic() + 60)
+    assert found is not None
+    assert refutation_problem(found, decrease.query, plan.states) is None
+    monkeypatch.setattr(sos_refutation, "RAISED_MAX_ENTRIES", 0)  # no raised programs
+    assert sos_refutation.refute(decrease.query, plan.states, time.monotonic() + 60) is None

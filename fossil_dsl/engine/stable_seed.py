@@ -54,7 +54,23 @@ def _seeds(plan, networks, controller, samples):
 def _lqr_seed(plan, networks, controller, samples, A, K, discrete: bool):
     P = lyapunov_matrix(A, discrete)
     if P is not None:
+        P = P * _margin_scale(P, A, discrete, plan.options.margin)
         yield _has_room(plan, P), _quadratic_setter(networks, controller, samples, P, K)
+
+
+MARGIN_CUSHION = 4.0  # times the learner's margin that the seed's linear part keeps
+
+
+def _margin_scale(P: np.ndarray, A: np.ndarray, discrete: bool, margin: float) -> float:
+    """The factor (at least 1) that lifts x^T P x and its linear decrease above the
+    learner's margins (V >= m|x|^2, change <= -m|x|^2): P has largest eigenvalue 1, so an
+    ill-conditioned P misses them, the learner trains on, and the valid seed is lost (a
+    4-state map with one torque, probe48/c12: P's eigenvalues 0.004 to 1, and after one
+    step of training V was indefinite and the gain 2 500). V's scale does not matter to
+    any property's conditions."""
+    decrease = P - A.T @ P @ A if discrete else -(A.T @ P + P @ A)
+    least = min(np.linalg.eigvalsh(P)[0], np.linalg.eigvalsh((decrease + decrease.T) / 2)[0])
+    return max(1.0, MARGIN_CUSHION * margin / least) if least > 0 else 1.0
 
 
 def _has_room(plan, P: np.ndarray) -> bool:

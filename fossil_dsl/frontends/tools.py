@@ -36,7 +36,10 @@ def command_bench(args: argparse.Namespace) -> int:
                                      last="")
 
             def advance(run) -> None:
-                progress.update(task, advance=1, last=f"{run.spec} seed {run.seed}: {run.outcome}")
+                line = f"{run.spec} seed {run.seed}: {run.outcome}"
+                progress.update(task, advance=1, last=line)
+                if not err.is_terminal:  # a log gets one line per run; a bar shows nothing
+                    err.print(f"{line} ({run.wall:.1f} s)", markup=False, highlight=False)
 
             infos, runs = bench.run_all(paths, args.seeds, args.jobs, args.verifier,
                                         args.timeout, advance, executor)

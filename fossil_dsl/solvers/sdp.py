@@ -17,6 +17,14 @@ import numpy as np
 from fossil_dsl.ir import polynomials as P
 
 
+# The sum over Gram blocks of (entries of the block's upper triangle)^3 that Clarabel
+# gets through in a second, about: the dense block Hessians dominate its iterations. On a
+# machine about 5 times slower than usual, a 5-state program with one 125-monomial block
+# and ten of 55 (5e11) took 118 s against a time limit of 20 s; the rate is set for a
+# usual machine (programs up to 4 times over the limit there are not tried)
+CUBED_ENTRIES_PER_SECOND = 1e10
+
+
 class Program:
     """Gram blocks, scalars, polynomial identities (every coefficient zero; terms go to
     the current one, `new_identity` starts the next), linear equalities and
@@ -74,7 +82,16 @@ class Program:
             key = (self.tag, monomial)
             self.constant[key] = self.constant.get(key, 0.0) + float(coefficient)
 
+    def too_costly(self, seconds: float) -> bool:
+        """Whether the program would take much longer than `seconds` (Clarabel heeds its
+        time limit only between iterations, and its setup not at all)."""
+        return sum(math.comb(len(basis) + 1, 2) ** 3 for _, basis in self.blocks) \
+            > seconds * CUBED_ENTRIES_PER_SECOND
+
     def solve(self, objective: dict[int, float], seconds: float):
+        """The solution, or None: infeasible, unsolved in time, or too costly to try."""
+        if self.too_costly(seconds):
+            return None
         import clarabel
         from scipy import sparse
         rows, cols, values, right = [], [], [], []

@@ -42,6 +42,14 @@ MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
 # 6-state Lyapunov conditions with sin and tanh) are programs of a few hundred
 ATOMS_MAX_VARIABLES = 1_000
 MULTIPLIER_DECIMALS = 12  # kept of a refutation's multipliers
+# s0's Gram entries, at most, of a program with multipliers of raised degree (queries of
+# degree up to 12 in 2 states, 6 in 3 or 4 in 4)
+RAISED_MAX_ENTRIES = 1_000
+# and only for polynomial queries (not the abstractions of sin, tanh, ..., tried on every
+# query of the loop) of at least this degree: set relations (linear, quadratic) gain
+# nothing from them, and in 7 states each such query took 2 s more, which spent the
+# checker's 5 s for all of a spec's relations (probe48/c11 was refused as a bad spec)
+RAISED_FROM_DEGREE = 4
 POWERS = (1, 2)  # a strict comparison h > 0 enters as c h, else c h^2 (quartic decreases)
 
 
@@ -103,11 +111,16 @@ def _refuted_conjunction(query: L.Formula, states, deadline: float) -> Refutatio
     except ValueError:
         return None
     powers, limit = ((1,), ATOMS_MAX_VARIABLES) if abstract else (POWERS, MAX_VARIABLES)
-    for power, low, pairs in _variants(powers, None if abstract else opposite_bounds(atoms)):
+    for power, low, pairs, raised in _variants(powers,
+                                               None if abstract else opposite_bounds(atoms)):
         if time.monotonic() > deadline or _smallest_size(len(states), atoms, power) > limit:
             return None
+        if raised and (abstract or max(P.degree(h) for h, _ in atoms) < RAISED_FROM_DEGREE
+                       or _smallest_size(len(states), atoms, power, raised)
+                       > RAISED_MAX_ENTRIES):
+            break
         try:
-            program = _RefutationProgram(len(states), atoms, low, power, pairs)
+            program = _RefutationProgram(len(states), atoms, low, power, pairs, raised)
         except _Hopeless:
             continue
         if program.count > limit:
@@ -122,16 +135,20 @@ def _refuted_conjunction(query: L.Formula, states, deadline: float) -> Refutatio
 
 
 def _variants(powers, pairs):
-    """(power, low, products) of the programs tried, in order: each program with low 1
-    or 0 and the first power again with the box's products, if there are any (not in
-    every variant: a 3-state map's unrefutable query took 8.4 s instead of 3.3 s), and
-    none for abstracted queries, whose facts' bounds would make their programs larger."""
+    """(power, low, products, raised) of the programs tried, in order: each program with
+    low 1 or 0 and the first power again with the box's products, if there are any (not
+    in every variant: a 3-state map's unrefutable query took 8.4 s instead of 3.3 s), and
+    none for abstracted queries, whose facts' bounds would make their programs larger.
+    Last, where they are small, the programs with low 0 with multipliers of one degree
+    more (`raised`): a decrease on a sublevel set {V <= β} of a degree-6 V (probe48/c02,
+    tight against the basin) needs a multiplier of β - V of degree 4, not 2."""
     found = []
     for power, low in ((m, low) for m in powers for low in (1, 2, 0)):
-        found.append((power, low, ()))
+        found.append((power, low, (), 0))
         if pairs and power == powers[0] and low != 2:
-            found.append((power, low, pairs))
-    return found
+            found.append((power, low, pairs, 0))
+    return found + [(powers[0], 0, products, 1) for products in ((pairs,) if pairs else ())
+                    + ((),)]
 
 
 def opposite_bounds(atoms) -> list[tuple[int, int]] | None:
@@ -163,10 +180,11 @@ def _least_abstracted_size(query: L.Formula, states) -> int:
     return _gram_entries(len(states) + len(replaced), max(map(traversal.degree, sides)))
 
 
-def _smallest_size(n: int, atoms, power: int) -> int:
+def _smallest_size(n: int, atoms, power: int, raised: int = 0) -> int:
     """The entries of s0's Gram matrix alone (a lower bound on the program's size, known
     before building it: building a program of 700 000 variables took 9 s)."""
-    return _gram_entries(n, max(P.degree(h) * (power if strict else 1) for h, strict in atoms))
+    return _gram_entries(n, max(P.degree(h) * (power if strict else 1) for h, strict in atoms)
+                         + 2 * raised)
 
 
 def _gram_entries(n: int, degree: int) -> int:
@@ -183,12 +201,12 @@ class _RefutationProgram(Program):
     so that s0's Gram matrix survives rounding."""
 
     def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int, power: int,
-                 pairs: list[tuple[int, int]] = ()):
+                 pairs: list[tuple[int, int]] = (), raised: int = 0):
         super().__init__(n)
         self.atoms = [(P.power(h, power, n) if strict else h, strict) for h, strict in atoms]
         self.power = power
         top = max(2, max(P.degree(h) for h, _ in self.atoms))
-        half = (top + 1) // 2
+        half = (top + 1) // 2 + raised
         self.multipliers: list = []
         for h, strict in self.atoms:
             room = (2 * half - P.degree(h)) // 2
