@@ -61,11 +61,6 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
         if found is not None:
             return found
         notes.append(note)
-        if basin.holds_initial(plan):
-            found, note = _shaped_to_basin(plan, backend, listener, deadline)
-            if found is not None:
-                return found
-            notes.append(note)
     if backend is not None and sos_reach.applies(plan):
         found, note = _reach_sum_of_squares(plan, backend, listener, deadline)
         if found is not None:

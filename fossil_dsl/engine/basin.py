@@ -60,10 +60,6 @@ ITERATES = 300  # of a map, simulated
 ARRIVED = 1e-2  # of the scale: a trajectory this close to the origin has converged
 STUCK = 1e-4  # a decrease slack (per |y|^2) above which the point is given up
 SIGNIFICANT = 7  # digits kept of each coefficient
-INITIAL_MAX_STATES = 2  # for the attempt after the sum-of-squares program
-INITIAL_SAMPLES = 500  # of I, and as many of its boundary, for a region of attraction of I
-INITIAL_TOP = 0.9  # V asked at most this on them, so that a level between I and ∂D is below 1
-INITIAL_WEIGHT = 10.0  # of their hinges, against 1 for all the basin's samples together
 
 
 @dataclass(frozen=True)
@@ -82,22 +78,9 @@ class BasinFinding:
 
 
 def applies(plan: Plan) -> bool:
-    """`region: largest`: the run's first attempt."""
-    return plan.options.largest_region and _shapeable(plan)
-
-
-def holds_initial(plan: Plan) -> bool:
-    """A region of attraction of a given I in the plane: an attempt after the
-    sum-of-squares program (whose V must decrease on all of D, which fails where the
-    basin is smaller than D). From 3 states on its programs take much of the run (a
-    3-state ROA that learning certifies in 20 s: 116 s with it first)."""
-    return not plan.options.largest_region and len(plan.states) <= INITIAL_MAX_STATES \
-        and _shapeable(plan)
-
-
-def _shapeable(plan: Plan) -> bool:
     spec = plan.spec
-    return (plan.certificate.form in ROA_FORMS and not spec.inputs
+    return (plan.options.largest_region and plan.certificate.form in ROA_FORMS
+            and not spec.inputs
             and plan.controller is None and spec.torch_dynamics is None
             and spec.synthesis.certificate is None and spec.synthesis.candidate is None
             and spec.domain.bounding_box() is not None and _jacobian(plan) is not None)
@@ -176,14 +159,7 @@ class _Samples:
         converging = self._converges(points)
         edge = sample(Boundary(spec.domain), self.states, BOUNDARY_SAMPLES, rng,
                       spec.domain.bounding_box())
-        initial = _initial_samples(plan, rng)
-        self.basin = np.concatenate([points[converging], initial])
-        # I's points are asked to lie well inside {V <= 1}, and weigh more: a region of
-        # attraction that misses part of I proves nothing about it
-        self.tops = np.concatenate([np.ones(int(converging.sum())),
-                                    np.full(len(initial), INITIAL_TOP)])
-        self.weights = np.concatenate([np.full(int(converging.sum()), 1.0 / max(1, converging.sum())),
-                                       np.full(len(initial), INITIAL_WEIGHT / max(1, len(initial)))])
+        self.basin = points[converging]
         # the box's corners too: a face sampler rarely lands on one, and V dipped to 0.18
         # at a corner of the two-machine domain
         corners = np.array(list(itertools.product(*zip(low, high))))
@@ -306,17 +282,6 @@ class _Program:
         failing = v[(dv >= 0) | (v <= 0)]
         level = min(1.0, float(failing.min()) if len(failing) else 1.0)
         return float(np.mean(self.values(basin) @ c <= level))
-
-
-def _initial_samples(plan: Plan, rng: np.random.Generator) -> np.ndarray:
-    """Points of I and of its boundary (none for `region: largest`, which has no I to
-    hold)."""
-    if plan.options.largest_region or plan.certificate.form not in ROA_FORMS:
-        return np.zeros((0, len(plan.states)))
-    initial, box = plan.certificate.role("initial"), plan.spec.domain.bounding_box()
-    inner = sample(initial, plan.states, INITIAL_SAMPLES, rng, box)
-    edge = sample(Boundary(initial), plan.states, INITIAL_SAMPLES, rng, box)
-    return np.concatenate([np.asarray(inner, float), np.asarray(edge, float)])
 
 
 def _jacobian(plan: Plan) -> np.ndarray | None:

@@ -19,8 +19,8 @@ DECREASE_WEIGHT = 100.0  # of a decrease slack against the coverage objective
 
 
 def solve_conic(program, basin, outside, decrease, deadline: float):
-    """(c, decrease slacks) or None, from Clarabel: variables c, hinge h >= V - top on the
-    basin (top 1, less on I's points; each hinge weighed by the samples' weights), slack t >= dV/dt + eps|y|^2 on the decrease points."""
+    """(c, decrease slacks) or None, from Clarabel: variables c, hinge h >= V - 1 on the
+    basin, slack t >= dV/dt + eps|y|^2 on the decrease points."""
     import clarabel
     from scipy import sparse
     s = program.samples
@@ -35,7 +35,7 @@ def solve_conic(program, basin, outside, decrease, deadline: float):
     per_basin = 1.0 / s.squared(basin)[:, None]
     per_decrease = 1.0 / s.squared(decrease)[:, None]
     # A z + s = b with s >= 0: each block is "A z <= b"
-    blocks = [(on_c(basin_values) - hinge, s.tops),
+    blocks = [(on_c(basin_values) - hinge, np.ones(nb)),
               (-on_c(program.values(outside)), -np.ones(len(outside))),
               (-on_c(basin_values * per_basin), -np.full(nb, EPS)),
               (on_c(program.changes(decrease) * per_decrease) - slack, -np.full(nd, EPS)),
@@ -45,7 +45,7 @@ def solve_conic(program, basin, outside, decrease, deadline: float):
     right = np.concatenate([r for _, r in blocks] + [cones_right])
     rows = sum(len(r) for _, r in blocks)
     cones = [clarabel.NonnegativeConeT(rows)] + [clarabel.PSDTriangleConeT(quadratic)] * 2
-    objective = np.concatenate([np.zeros(m), s.weights,
+    objective = np.concatenate([np.zeros(m), np.full(nb, 1.0 / max(nb, 1)),
                                 np.full(nd, DECREASE_WEIGHT / max(nd, 1))])
     settings = clarabel.DefaultSettings()
     settings.verbose = False
