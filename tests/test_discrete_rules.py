@@ -172,7 +172,7 @@ def test_the_continuous_reading_is_fooled_and_the_discrete_rule_is_not(name):
 @pytest.mark.parametrize("name", sorted(PITFALLS))
 def test_synthesis_never_certifies_the_false_discrete_properties(name):
     spec = fossil_dsl.loads(PITFALLS[name].spec, "pitfall.fsl")
-    result = fossil_dsl.synthesise(spec, seed=0, max_iters=4, timeout=30)
+    result = fossil_dsl.synthesise(spec, seed=0, max_iters=4, timeout=15)
     assert not result.certified
 
 

@@ -215,6 +215,13 @@ class _Program:
         self.outside = samples.outside
         self.decrease = samples.decrease
         self.near = np.ones(len(self.decrease), bool)  # never moved outside
+        # the fixed samples' monomials, once (each round anew they took 21 s of a 57 s
+        # search in 2 states)
+        self.basin_values = self.values(samples.basin)
+        self.check_points = np.concatenate([samples.basin, samples.checks])
+        self.check_values = np.concatenate([self.basin_values, self.values(samples.checks)])
+        self.check_changes = self.changes(self.check_points)
+        self.edge_values = self.values(samples.edge_checks)
 
     def values(self, x: np.ndarray) -> np.ndarray:
         """Each monomial of y = x / scale at each point: shape [N, m]."""
@@ -252,36 +259,38 @@ class _Program:
         for round_ in range(1, ROUNDS + 1):
             if time.monotonic() > deadline:
                 break
-            solved = solve_conic(self, s.basin, self.outside, self.decrease, deadline)
+            solved = solve_conic(self, self.outside, self.decrease, deadline)
             if solved is None:
                 break
             c, slack = solved
             stuck = (slack > STUCK) & ~self.near
             self.outside = np.concatenate([self.outside, self.decrease[stuck]])
             self.decrease, self.near = self.decrease[~stuck], self.near[~stuck]
-            failing = self._failing(c, s.basin, s.checks)
-            low_edge = s.edge_checks[self.values(s.edge_checks) @ c < 1][:ADDED_PER_ROUND]
+            failing = self._failing(c)
+            low_edge = s.edge_checks[self.edge_values @ c < 1][:ADDED_PER_ROUND]
             self.outside = np.concatenate([self.outside, low_edge])
-            found = (c, self._coverage(c, s.basin, s.checks), round_)
+            found = (c, self._coverage(c), round_)
             if not len(failing) and not stuck.any() and not len(low_edge):
                 break
             self.require(failing)
         return found
 
-    def _failing(self, c, basin, checks) -> np.ndarray:
-        """Points (basin samples first) with V <= 1 where V <= 0 or decrease fails."""
-        points = np.concatenate([basin, checks])
-        v, dv = self.values(points) @ c, self.changes(points) @ c
+    def _failing(self, c) -> np.ndarray:
+        """Points (basin samples first, then the checks) with V <= 1 where V <= 0 or
+        decrease fails."""
+        points = self.check_points
+        v, dv = self.check_values @ c, self.check_changes @ c
         bad = (v <= 1) & ((dv > -EPS * self.samples.squared(points)) | (v <= 0))
         return points[bad][:ADDED_PER_ROUND]
 
-    def _coverage(self, c, basin, checks) -> float:
+    def _coverage(self, c) -> float:
         """Share of the basin's samples below the largest level at which every check
         point decreases."""
-        v, dv = self.values(checks) @ c, self.changes(checks) @ c
+        checks = slice(len(self.basin_values), None)
+        v, dv = self.check_values[checks] @ c, self.check_changes[checks] @ c
         failing = v[(dv >= 0) | (v <= 0)]
         level = min(1.0, float(failing.min()) if len(failing) else 1.0)
-        return float(np.mean(self.values(basin) @ c <= level))
+        return float(np.mean(self.basin_values @ c <= level))
 
 
 def _jacobian(plan: Plan) -> np.ndarray | None:

@@ -3,7 +3,8 @@
 each decrease point; linear rows for the sampled conditions (each divided by |y|^2, so
 points near the origin weigh like the others) and two positive semidefinite cones for
 V's quadratic part Q: Q >= e I and -(A^T Q + Q A) >= e I (Q - A^T Q A >= e I for a map). The program object supplies
-`values`, `changes`, `exponents` and `samples` (`squared`, `jacobian`)."""
+`values`, `changes`, `basin_values`, `exponents` and `samples` (`basin`, `squared`,
+`jacobian`)."""
 from __future__ import annotations
 
 import math
@@ -18,18 +19,19 @@ LOCAL_EPS = 2e-2
 DECREASE_WEIGHT = 100.0  # of a decrease slack against the coverage objective
 
 
-def solve_conic(program, basin, outside, decrease, deadline: float):
+def solve_conic(program, outside, decrease, deadline: float):
     """(c, decrease slacks) or None, from Clarabel: variables c, hinge h >= V - 1 on the
     basin, slack t >= dV/dt + eps|y|^2 on the decrease points."""
     import clarabel
     from scipy import sparse
     s = program.samples
+    basin = s.basin
     m, nb, nd = len(program.exponents), len(basin), len(decrease)
     hinge = sparse.hstack([sparse.csr_matrix((nb, m)), sparse.eye(nb), sparse.csr_matrix((nb, nd))])
     slack = sparse.hstack([sparse.csr_matrix((nd, m + nb)), sparse.eye(nd)])
     on_c = lambda rows: sparse.hstack([sparse.csr_matrix(rows),
                                        sparse.csr_matrix((len(rows), nb + nd))])
-    basin_values = program.values(basin)
+    basin_values = program.basin_values
     # rows divided by |y|^2: points near the origin weigh like the others (unscaled, their
     # 1e-9 margins were below the solver's tolerance)
     per_basin = 1.0 / s.squared(basin)[:, None]
