@@ -209,3 +209,26 @@ def test_an_ill_conditioned_seed_is_scaled_to_meet_the_learners_margins():
     assert (values >= 2 * plan.options.margin * (points ** 2).sum(1)).all()
     result = fossil_dsl.synthesise(plan.spec, seed=0, timeout=120)
     assert result.certified and result.iterations == 1, result.summary()
+
+
+def test_the_first_controller_seed_is_lqrs_own_riccati_function():
+    """probe49/e09, a pendulum on a cart (u enters as cos(th) u): for the identity
+    weights' gain, V from the Lyapunov equation with decrease I rose along the closed
+    loop (by up to 0.75 |x|^2 on D); the Riccati solution S, which the closed loop decreases at
+    I + K^T K and which tolerates the input's gain falling to cos(0.5), is the seed."""
+    from scipy.linalg import solve_continuous_are
+    path = Path(__file__).resolve().parent.parent / \
+        "specs/probe49/e09_pendulum_cart_velocity_stab_ctrl.fsl"
+    plan = compile_spec(fossil_dsl.loads(path.read_text()))
+    A = np.array([[0.0, 1, 0], [1, 0, 0], [0, 0, 0]])
+    B = np.array([[0.0], [-1], [1]])
+    S = solve_continuous_are(A, B, np.eye(3), np.eye(1))
+    K = B.T @ S
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    assert learner.seeded and learner.loss()[1]
+    points = torch.rand(500, 3, dtype=torch.float64) - 0.5
+    inputs = learner.controller(points).detach().numpy().reshape(len(points))
+    assert np.allclose(inputs, -(points.numpy() @ K.T)[:, 0], atol=1e-3)
+    ratios = learner.networks["V"](points).detach().numpy().ravel() / np.einsum(
+        "ni,ij,nj->n", points.numpy(), S, points.numpy())
+    assert np.ptp(ratios) < 1e-3 * ratios.mean()  # V is a multiple of x^T S x

@@ -236,3 +236,26 @@ def test_forged_products_are_rejected():
     # a product of comparisons that are not the box's bounds: the identity no longer holds
     swapped = replace(found, products=(replace(product, first=0, second=2),) + found.products[1:])
     assert refutation_problem(swapped, BOX_AND_FAR, STATES) is not None
+
+
+def test_a_query_away_from_the_origin_tries_constant_terms_first(monkeypatch):
+    """A map's reach decrease outside the goal disc: V(f(x)) - V(x) > -1/100 for
+    f(x) = x / 2, V = |x|^2, and |x|^2 >= 1/25. The origin violates the disc's
+    exclusion, so programs with low 1 or 2 (every term vanishing at the origin but the
+    strict comparison's constant 1/100) cannot hold there: the first program tried has
+    constant terms, and it is the refutation."""
+    import time
+    step = E.mul(E.Num(F(-3, 4)), NORM)  # V(x / 2) - V(x)
+    query = L.conjunction(L.Compare(">", step, E.Num(F(-1, 100))),
+                          L.Compare(">=", NORM, E.Num(F(1, 25))),
+                          L.Compare("<=", NORM, E.Num(F(1))))
+    solved = []
+    original = sos_refutation._RefutationProgram.solve
+    def counted(program, *args):
+        solved.append(program)
+        return original(program, *args)
+    monkeypatch.setattr(sos_refutation._RefutationProgram, "solve", counted)
+    found = sos_refutation.refute(query, STATES, time.monotonic() + 30)
+    assert found is not None and refutation_problem(found, query, STATES) is None
+    assert len(solved) == 1
+

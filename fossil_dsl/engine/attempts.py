@@ -31,8 +31,10 @@ SOS_QUERY_SECONDS = 5.0
 # the shaped V has no cheaper alternative in a `region: largest` run (a degree-8 decrease
 # condition near the excluded ball takes the interval procedure 5-20 s)
 BASIN_QUERY_SECONDS = 30.0
-# for refutations of the reach attempt's obligations (g04: its quartic V's refutations
-# took 40 s and failed; a quadratic V's are found in well under a second)
+# for refutations of the reach attempt's obligations, at least (g04: its quartic V's
+# refutations took 40 s and failed; a quadratic V's are found in well under a second),
+# else twice what its program took: a refutation program is as large (a 5-state map's
+# degree-6 decrease, probe49/e08: V found in 16 s, its decrease refuted in 12-18 s)
 REACH_REFUTING_SECONDS = 5.0
 CONSERVED_REFINEMENTS = 3  # conserved-quantity barriers chosen again with counterexamples
 BASIN_TOTAL_SHARE = 0.5  # of the run's time, at most, for the whole attempt
@@ -189,7 +191,8 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
     if finding is None:
         return None, "no sum-of-squares reach certificate found"
     prepare = (lambda cegis: _controller_set(cegis, finding)) if finding.controller else None
-    return _proved(plan, backend, listener, deadline, finding, REACH_REFUTING_SECONDS,
+    refuting = max(REACH_REFUTING_SECONDS, 2 * finding.seconds)
+    return _proved(plan, backend, listener, deadline, finding, refuting,
                    formulas=finding.formulas, prepare=prepare)
 
 

@@ -1,7 +1,10 @@
 """A sum-of-squares attempt for reach-type properties (reach, RWA, RAR) of a polynomial
 ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where the decrease
-is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py); where the system has inputs, with a linear controller fixed beforehand to an LQR
-gain of its linearisation, rounded as the verifier will see it.
+is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py), and for
+reach and RWA of a polynomial map (the decrease is V(f(x)) - V(x), still linear in V's
+coefficients; the kernel's further condition that a step from S outside G with V <= 0
+lands in S is left to the proof); where the system has inputs, with a linear controller
+fixed beforehand to an LQR gain of its linearisation, rounded as the verifier will see it.
 
 V (a polynomial of degree 2 or 4, coefficients in [-100, 100]) and the largest e with
 
@@ -42,6 +45,7 @@ from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
 
 FORMS = ("reach while avoid", "reach", "reach-avoid-remain")
+DISCRETE_FORMS = ("reach while avoid", "reach")
 HALF_DEGREES = (1, 2)  # V of degree 2, then 4
 DECIMALS = 6  # kept of V's coefficients
 MIN_MARGIN = 1e-6
@@ -71,10 +75,12 @@ class ReachFinding:
 
 
 def applies(plan: Plan) -> bool:
-    """A polynomial or rational ODE, a reach-type property, the default templates, and
-    at most a linear controller (the default one)."""
+    """A polynomial or rational ODE, or a polynomial map for reach and RWA (RAR's
+    barrier program is for ODEs), a reach-type property, the default templates, and at
+    most a linear controller (the default one)."""
     spec = plan.spec
-    return (plan.certificate.form in FORMS and spec.time is TimeDomain.CONTINUOUS
+    discrete = spec.time is TimeDomain.DISCRETE
+    return (plan.certificate.form in (DISCRETE_FORMS if discrete else FORMS)
             and default_synthesis(plan)
             and all(traversal.is_arithmetic(f) for f in spec.dynamics))
 
@@ -92,18 +98,20 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
         return None
     rng = np.random.default_rng(plan.options.seed)
     box = spec.domain.bounding_box()
+    discrete = spec.time is TimeDomain.DISCRETE
     for controller, gain in _controllers(plan, operating, rng):
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
         field = _polynomial(closed, states)
         denominator = P.constant(1, len(states))
         if field is None:  # a rational field: the programs are multiplied through by Q
-            found = over_one_denominator(closed, states, box, plan.options.seed)
+            found = None if discrete else over_one_denominator(closed, states, box,
+                                                               plan.options.seed)
             if found is None or pieces.outside_final is not None:
                 continue  # (RAR's barrier program is for polynomial fields)
             field, denominator = found
         if time.monotonic() > deadline:
             continue
-        found = _functions(len(states), field, denominator, pieces, deadline)
+        found = _functions(len(states), field, denominator, pieces, deadline, discrete)
         if found is not None:
             formulas, degree, margin = found
             return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
@@ -185,9 +193,10 @@ class _Pieces:
                 for g in _constraints(region, states)]
 
 
-def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float):
+def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
+               discrete: bool = False):
     """({"V": V, "B": B for RAR}, V's degree, margin) or None; the field is
-    field / denominator (denominator > 0 on D)."""
+    field / denominator (denominator > 0 on D), or the map (`discrete`)."""
     b = None
     if pieces.outside_final is not None:
         b = _barrier(n, field, pieces, deadline)
@@ -196,7 +205,7 @@ def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float):
     for half in HALF_DEGREES:
         if time.monotonic() > deadline:
             return None
-        program = _ReachProgram(n, field, denominator, pieces, half)
+        program = _ReachProgram(n, field, denominator, pieces, half, discrete)
         if program.count > MAX_VARIABLES:
             return None
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
@@ -222,7 +231,8 @@ def _barrier(n: int, field, pieces: _Pieces, deadline: float):
 
 
 class _ReachProgram(Program):
-    def __init__(self, n: int, field, denominator, pieces: _Pieces, half: int):
+    def __init__(self, n: int, field, denominator, pieces: _Pieces, half: int,
+                 discrete: bool = False):
         super().__init__(n)
         self.basis = P.monomials(n, 0, 2 * half)
         self.coefficients = [self.scalar() for _ in self.basis]
@@ -235,9 +245,10 @@ class _ReachProgram(Program):
         self.require(negated, pieces.initial)
         for piece in pieces.boundary:
             self.require(list(zip(self.coefficients, terms)), piece)
-        decrease = [(v, P.scale(P.lie_derivative(t, field), -1))
+        decrease = [(v, P.scale(P.change(t, field, discrete), -1))
                     for v, t in zip(self.coefficients, terms)]
-        for piece in pieces.outside_goal:  # grad V . N <= -γ Q, that is dV/dt <= -γ
+        # grad V . N <= -γ Q, that is dV/dt <= -γ (for a map V(f(x)) - V(x) <= -γ)
+        for piece in pieces.outside_goal:
             self.require(decrease, piece, P.scale(denominator, -GAMMA))
 
     def require(self, terms, constraints, constant=None) -> None:

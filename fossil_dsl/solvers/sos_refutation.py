@@ -112,8 +112,10 @@ def _refuted_conjunction(query: L.Formula, states, deadline: float) -> Refutatio
         return None
     powers, limit = ((1,), ATOMS_MAX_VARIABLES) if abstract else (POWERS, MAX_VARIABLES)
     bounds = None if abstract else opposite_bounds(atoms)
+    lows = (0, 1, 2) if not abstract and _origin_left_out(atoms, len(states)) else (1, 2, 0)
     for power, low, pairs, raised in _variants(powers, bounds,
-                                               _raise_worthwhile(abstract, states, atoms)):
+                                               _raise_worthwhile(abstract, states, atoms),
+                                               lows):
         if time.monotonic() > deadline or _smallest_size(len(states), atoms, power) > limit:
             return None
         try:
@@ -139,16 +141,29 @@ def _raise_worthwhile(abstract: bool, states, atoms) -> bool:
             and _smallest_size(len(states), atoms, POWERS[0], 1) <= RAISED_MAX_ENTRIES)
 
 
-def _variants(powers, pairs, raise_too: bool):
+def _origin_left_out(atoms, n: int) -> bool:
+    """Whether the origin violates one of the comparisons (h(0) < 0). In a program with
+    low 1 or 2, s0 and every multiplier vanish at the origin, so the identity there
+    leaves only the strict comparisons' constants, which must cancel; such programs are
+    made for conditions that hold up to the origin (the kernel's lemma near it). Where
+    the origin violates the query, programs with constant terms come first: a 5-state
+    map's reach decrease (probe49/e08) failed three low-1 and low-2 programs (11 s)
+    before the low-0 one (12 s)."""
+    zero = (0,) * n
+    return any(h.get(zero, 0) < 0 for h, _ in atoms)
+
+
+def _variants(powers, pairs, raise_too: bool, lows=(1, 2, 0)):
     """(power, low, products, raised) of the programs tried, in order: each program with
-    low 1 or 0 and the first power again with the box's products, if there are any (not
+    each low of `lows` in turn (1, 2, 0; 0 first where the origin is left out) and the
+    first power again with the box's products, if there are any (not
     in every variant: a 3-state map's unrefutable query took 8.4 s instead of 3.3 s), and
     none for abstracted queries, whose facts' bounds would make their programs larger.
     Last, where they are small, the programs with low 0 with multipliers of one degree
     more (`raised`): a decrease on a sublevel set {V <= β} of a degree-6 V (probe48/c02,
     tight against the basin) needs a multiplier of β - V of degree 4, not 2."""
     found = []
-    for power, low in ((m, low) for m in powers for low in (1, 2, 0)):
+    for power, low in ((m, low) for m in powers for low in lows):
         found.append((power, low, (), 0))
         if pairs and power == powers[0] and low != 2:
             found.append((power, low, pairs, 0))
