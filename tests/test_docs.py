@@ -9,7 +9,6 @@ and every documented line without digits (timings and weights vary) must be prin
 """
 from __future__ import annotations
 
-import os
 import re
 import shlex
 import subprocess
@@ -70,14 +69,12 @@ def console_cases():
 
 
 @pytest.mark.parametrize("command, output", console_cases())
-def test_console_examples_run_as_shown(command, output, tmp_path):
+def test_console_examples_run_as_shown(command, output, fossilc):
+    """Run through the session's shared runs (tests/conftest.py): test_region.py looks
+    into what the tutorial's largest-region commands produced."""
     words = shlex.split(command)
     assert words[0] == "fossilc", f"docs commands are fossilc commands: {command}"
-    for folder in ("specs", "benchmarks"):
-        (tmp_path / folder).symlink_to(ROOT / folder)
-    env = {**os.environ, "COLUMNS": "200"}
-    run = subprocess.run([sys.executable, "-m", "fossil_dsl.frontends.cli", *words[1:]], cwd=tmp_path,
-                         capture_output=True, text=True, timeout=600, env=env)
+    run = fossilc(words[1:])
     printed = run.stdout + run.stderr
     text = "\n".join(output)
     expected = 2 if "error:" in text else 1 if "NOT CERTIFIED" in text else 0

@@ -259,3 +259,29 @@ def test_a_query_away_from_the_origin_tries_constant_terms_first(monkeypatch):
     assert found is not None and refutation_problem(found, query, STATES) is None
     assert len(solved) == 1
 
+
+
+def test_monomials_whose_square_nothing_cancels_leave_s0s_basis():
+    """x^4 + 1 - w x <= 0 with |w| <= 1 (w stands for a function's value, bounded only
+    linearly): no term of the identity holds w^4, so w^2's diagonal entry in s0's Gram
+    matrix is 0 in every solution and s0 + tI had t = 0, which no rounding survives.
+    Without w^2 (and what it alone cancelled) the first program is a refutation."""
+    from fossil_dsl.solvers.positivstellensatz import comparisons
+    w = E.Var("w")
+    h = E.add(E.power(X, E.Num(F(4))), E.Num(F(1)), E.neg(E.mul(w, X)))
+    query = L.conjunction(L.Compare("<=", h, E.ZERO), L.Compare("<=", w, E.Num(F(1))),
+                          L.Compare(">=", w, E.Num(F(-1))))
+    states = ("x", "w")
+    program = sos_refutation._RefutationProgram(2, comparisons(query, states), 0, 1)
+    assert (0, 2) not in program.basis and (2, 0) in program.basis
+    x = program.solve({program.interior: -1.0}, 20)
+    assert x[program.interior] > 0.5
+    found = program.exact(x)
+    assert found is not None and refutation_problem(found, query, states) is None
+    # the pruning itself: kept where the rest of the identity has m^2, or m^2 is a
+    # product of two other kept monomials; repeated until nothing more goes
+    basis = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]
+    assert sos_refutation.cancellable(basis, {(0, 0), (4, 0), (2, 0)}) == [(0, 0), (1, 0),
+                                                                           (2, 0)]
+    assert sos_refutation.cancellable(basis, {(0, 0), (4, 0), (0, 4)}) == [
+        (0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]

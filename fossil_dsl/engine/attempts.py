@@ -31,10 +31,11 @@ SOS_QUERY_SECONDS = 5.0
 # the shaped V has no cheaper alternative in a `region: largest` run (a degree-8 decrease
 # condition near the excluded ball takes the interval procedure 5-20 s)
 BASIN_QUERY_SECONDS = 30.0
-# for refutations of the reach attempt's obligations, at least (g04: its quartic V's
-# refutations took 40 s and failed; a quadratic V's are found in well under a second),
-# else twice what its program took: a refutation program is as large (a 5-state map's
-# degree-6 decrease, probe49/e08: V found in 16 s, its decrease refuted in 12-18 s)
+# the reach attempt's refutations get twice what its program took, and at least this:
+# a refutation program is about as large as the program (a 5-state map's degree-6
+# decrease, probe49/e08: V found in 16 s, its decrease refuted in 12-18 s), and a small
+# floor keeps hopeless ones short (g04: its quartic V's refutations took 40 s and failed;
+# a quadratic V's are found in well under a second)
 REACH_REFUTING_SECONDS = 5.0
 CONSERVED_REFINEMENTS = 3  # conserved-quantity barriers chosen again with counterexamples
 BASIN_TOTAL_SHARE = 0.5  # of the run's time, at most, for the whole attempt

@@ -20,7 +20,8 @@ from fractions import Fraction
 
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.engine.sos import MIN_MARGIN, SosFinding, field_of, set_constraints
-from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
+from fossil_dsl.solvers.gram_rounding import decimal
+from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.plan.compile import Plan

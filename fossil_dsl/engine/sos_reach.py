@@ -42,7 +42,8 @@ from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.rwa import GAMMA
 from fossil_dsl.plan.compile import Plan, default_synthesis
 from fossil_dsl.solvers.sdp import Program
-from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, decimal
+from fossil_dsl.solvers.gram_rounding import decimal
+from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 
 FORMS = ("reach while avoid", "reach", "reach-avoid-remain")
 DISCRETE_FORMS = ("reach while avoid", "reach")
@@ -194,7 +195,7 @@ class _Pieces:
 
 
 def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
-               discrete: bool = False):
+               discrete: bool):
     """({"V": V, "B": B for RAR}, V's degree, margin) or None; the field is
     field / denominator (denominator > 0 on D), or the map (`discrete`)."""
     b = None
@@ -232,7 +233,7 @@ def _barrier(n: int, field, pieces: _Pieces, deadline: float):
 
 class _ReachProgram(Program):
     def __init__(self, n: int, field, denominator, pieces: _Pieces, half: int,
-                 discrete: bool = False):
+                 discrete: bool):
         super().__init__(n)
         self.basis = P.monomials(n, 0, 2 * half)
         self.coefficients = [self.scalar() for _ in self.basis]

@@ -26,11 +26,11 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.solvers.api import Answer, Status
 from fossil_dsl.solvers.atom_facts import has_atoms, replaceable
+from fossil_dsl.solvers.gram_rounding import (MULTIPLIER_DECIMALS, decimal, projected,
+                                             psd_square)
 from fossil_dsl.solvers.positivstellensatz import (CaseSplit, Evidence, Power, Product,
-                                                  Refutation,
-                                                  SumOfSquares, cases, comparisons, conjuncts,
-                                                  disjunction_branches,
-                                                  polynomial_form, positive_semidefinite,
+                                                  Refutation, cases, comparisons, conjuncts,
+                                                  disjunction_branches, polynomial_form,
                                                   refutation_problem)
 from fossil_dsl.solvers.sdp import Program
 
@@ -41,7 +41,6 @@ MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
 # 2600 variables 0.3 to 5.5 s each, none a refutation; the refutations found (4- and
 # 6-state Lyapunov conditions with sin and tanh) are programs of a few hundred
 ATOMS_MAX_VARIABLES = 1_000
-MULTIPLIER_DECIMALS = 12  # kept of a refutation's multipliers
 # s0's Gram entries, at most, of a program with multipliers of raised degree (queries of
 # degree up to 12 in 2 states, 6 in 3 or 4 in 4)
 RAISED_MAX_ENTRIES = 1_000
@@ -156,9 +155,9 @@ def _origin_left_out(atoms, n: int) -> bool:
 def _variants(powers, pairs, raise_too: bool, lows=(1, 2, 0)):
     """(power, low, products, raised) of the programs tried, in order: each program with
     each low of `lows` in turn (1, 2, 0; 0 first where the origin is left out) and the
-    first power again with the box's products, if there are any (not
-    in every variant: a 3-state map's unrefutable query took 8.4 s instead of 3.3 s), and
-    none for abstracted queries, whose facts' bounds would make their programs larger.
+    first power again with the box's products, if there are any (not in every variant: a
+    3-state map's unrefutable query took 8.4 s instead of 3.3 s), and none for abstracted
+    queries, whose facts' bounds would make their programs larger.
     Last, where they are small, the programs with low 0 with multipliers of one degree
     more (`raised`): a decrease on a sublevel set {V <= β} of a degree-6 V (probe48/c02,
     tight against the basin) needs a multiplier of β - V of degree 4, not 2."""
@@ -261,7 +260,7 @@ class _RefutationProgram(Program):
         if not strict:
             raise _Hopeless()
         self.equalities.append(({c: 1.0 for c in strict}, 1.0))
-        self.basis = P.monomials(n, low, half)
+        self.basis = cancellable(P.monomials(n, low, half), {m for _, m in self.identity})
         self.rest = self.gram(self.basis)
         self.interior = self.scalar()
         self.add_term(self.interior, {P.times(m, m): Fraction(1) for m in self.basis})
@@ -280,14 +279,14 @@ class _RefutationProgram(Program):
                 total = P.add(total, P.scale(h, c))
                 continue
             _, basis, entries = multiplier
-            square = _psd_square(basis, self.matrix(x, entries, len(basis)))
+            square = psd_square(basis, self.matrix(x, entries, len(basis)))
             if square is None:
                 return None
             multipliers.append(square)
             total = P.add(total, P.multiply(square.polynomial(), h))
         products = []
         for i, k, basis, entries, h in self.products:
-            square = _psd_square(basis, self.matrix(x, entries, len(basis)))
+            square = psd_square(basis, self.matrix(x, entries, len(basis)))
             if square is None:
                 return None
             products.append(Product(i, k, square))
@@ -297,53 +296,27 @@ class _RefutationProgram(Program):
             constant = max(Fraction(0), decimal(x[self.constant_term], MULTIPLIER_DECIMALS))
             total = P.add(total, P.constant(constant, self.n))
         G = self.matrix(x, self.rest, len(self.basis)) + x[self.interior] * np.eye(len(self.basis))
-        rest = _projected(self.basis, G, P.scale(total, -1))
+        rest = projected(self.basis, G, P.scale(total, -1))
         if rest is None:
             return None
         return Refutation(tuple(multipliers), rest, constant, tuple(products))
 
 
+def cancellable(basis: list[P.Monomial], support: set[P.Monomial]) -> list[P.Monomial]:
+    """The monomials m of s0's Gram basis whose square s0 can hold: m^2 is a term the
+    rest of the identity can have (`support`), or a product of two other monomials kept.
+    Any other m has a zero diagonal entry in every solution, hence a zero row (the Gram
+    matrix is PSD), so dropping it loses nothing, and s0 + tI can then have t > 0: a
+    cart-pole's decrease with cos abstracted (probe49/e09) had w^4 in the basis with
+    nothing to cancel it, which forced t = 0. Repeated, as each drop removes products."""
+    kept = list(basis)
+    while True:
+        products = {P.times(a, b) for i, a in enumerate(kept) for b in kept[i + 1:]}
+        pruned = [m for m in kept if P.times(m, m) in support or P.times(m, m) in products]
+        if len(pruned) == len(kept):
+            return kept
+        kept = pruned
+
+
 class _Hopeless(Exception):
     """No strict comparison to refute with (and no constant in this basis)."""
-
-
-def decimal(value: float, decimals: int) -> Fraction:
-    return Fraction(round(float(value) * 10 ** decimals), 10 ** decimals) \
-        if math.isfinite(value) else Fraction(0)
-
-
-def _psd_square(basis, G: np.ndarray) -> SumOfSquares | None:
-    """G rounded to rationals; nudged up the diagonal if rounding left it indefinite."""
-    for nudge in (0.0, 1e-10, 1e-8):
-        gram = _rational_matrix(G + nudge * np.eye(len(basis)))
-        if positive_semidefinite(gram):
-            return SumOfSquares(tuple(basis), gram)
-    return None
-
-
-def _rational_matrix(G: np.ndarray) -> tuple[tuple[Fraction, ...], ...]:
-    size = len(G)
-    rows = [[decimal((G[i, j] + G[j, i]) / 2, MULTIPLIER_DECIMALS) for j in range(size)]
-            for i in range(size)]
-    return tuple(tuple(row) for row in rows)
-
-
-def _projected(basis, G: np.ndarray, target: P.Polynomial) -> SumOfSquares | None:
-    """The rational Gram matrix nearest to G (Frobenius) with m^T G m = target exactly,
-    if it is positive semidefinite: each entry (a, b) feeds one monomial m_a m_b, so the
-    projection spreads each monomial's residual evenly over its entries."""
-    gram = [list(row) for row in _rational_matrix(G)]
-    classes: dict[P.Monomial, list[tuple[int, int]]] = {}
-    for a, ma in enumerate(basis):
-        for b, mb in enumerate(basis):
-            classes.setdefault(P.times(ma, mb), []).append((a, b))
-    if any(monomial not in classes for monomial in target):
-        return None
-    for monomial, pairs in classes.items():
-        residual = target.get(monomial, Fraction(0)) - sum(gram[a][b] for a, b in pairs)
-        if residual:
-            share = residual / len(pairs)
-            for a, b in pairs:
-                gram[a][b] += share
-    rational = tuple(tuple(row) for row in gram)
-    return SumOfSquares(tuple(basis), rational) if positive_semidefinite(rational) else None
