@@ -223,7 +223,9 @@ def _wait_idle(executor: DaskExecutor) -> None:
     raise AssertionError("jobs still running 30 s after Ctrl-C")
 
 
-def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, capsys):
+def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, capsys, monkeypatch):
+    from fossil_dsl.cluster import executors
+    monkeypatch.setattr(executors, "CONNECT_SECONDS", 2.0)  # Dask retries until then
     address = f"tcp://127.0.0.1:{_free_port()}"
     code = main(["bench", str(QUICK[0]), "--seeds", "1", "--out", str(tmp_path),
                  "--cluster", address])

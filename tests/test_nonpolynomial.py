@@ -56,7 +56,8 @@ ONLY_REFUTED = {"ball:positive", "ball:decrease"}
 
 def recheck_from_text(result) -> None:
     """Every exported obligation, read back from its SMT-LIB text, is UNSAT for a fresh
-    interval verifier, and CVC5 never finds it satisfiable."""
+    interval verifier, and CVC5 reads it and does not find it satisfiable (in half a
+    second: it answers unknown on most transcendental ones, whatever its time)."""
     for name, script in result.obligations.items():
         if name.replace("-", ":") in ONLY_REFUTED:
             continue
@@ -66,7 +67,7 @@ def recheck_from_text(result) -> None:
             continue
         answer = IntervalBackend().check(read.formula, read.variables, timeout=120)
         assert answer.status is Status.UNSAT, (name, answer)
-        assert Cvc5Backend().check_text(script, timeout=2).status is not Status.SAT, name
+        assert Cvc5Backend().check_text(script, timeout=0.5).status is not Status.SAT, name
 
 
 def test_damped_pendulum_certified_with_the_ball_proved_apart():
