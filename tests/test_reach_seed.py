@@ -159,3 +159,39 @@ def test_box_floors_bound_the_quadratic_on_the_faces_and_on_the_box():
     sampled = np.einsum("bi,ij,bj->b", inside, P, inside).min()
     assert set_floor(P, away, centre) <= sampled + 1e-9
     assert set_floor(P, away, centre) >= sampled - 0.05 * sampled
+
+
+# an inverted pendulum map (specs/probe51/l06): I at th = 0.3..0.5, unsafe th <= -0.5, so
+# every ellipsoid round the origin that holds I meets the unsafe set
+PENDULUM_MAP_RWA = """\
+state th, w
+input u
+dynamics discrete {
+    next(th) = th + 0.1*w
+    next(w) = w + 0.1*(sin(th) - 0.2*w + u)
+}
+domain box([-1, -1.5], [1, 1.5])
+set init = box([0.3, -0.1], [0.5, 0.1])
+set goal = ball([0, 0], 0.15)
+set unsafe = { th <= -0.5 }
+prove from init: not unsafe until goal
+"""
+
+
+def test_where_no_ellipsoid_round_the_origin_fits_it_is_moved_into_g_towards_i():
+    from fossil_dsl.engine import reach_seed
+    import numpy as np
+    learner = learner_for(PENDULUM_MAP_RWA)
+    plan, rng = learner.plan, np.random.default_rng(0)
+    boundary = reach_seed._boundary_samples(plan, rng)
+    assert not reach_seed._fitting(plan, learner.networks, learner.samples, boundary,
+                                   np.zeros(2), np.zeros(1), rng)
+    centres = reach_seed._goal_centres(plan, learner.samples["initial"])
+    assert centres and all(0 < c[0] < 0.15 and c[1] == 0 for c in centres)
+    assert learner.seeded
+    V = learner.networks["V"]
+    at = torch.tensor(np.array([[0.0, 0.0], centres[0]]), dtype=torch.float64)
+    values = V(at).detach().flatten()
+    assert values[1] < values[0]  # V is least at the centre, not at the origin
+    result = fossil_dsl.synthesise(fossil_dsl.loads(PENDULUM_MAP_RWA), seed=0, timeout=60)
+    assert result.certified and result.iterations == 1, result.reason

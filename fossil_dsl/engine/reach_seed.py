@@ -11,8 +11,12 @@ Which P fits is a question of shape: the ellipsoid {x^T P x <= c} must hold I an
 the boundary of S. For each of several LQR weightings (which gain), a small
 semidefinite program finds the Lyapunov matrix of that closed loop under which the
 sampled boundary lies furthest out, relative to the sampled I; the pair with the largest
-ratio is kept. Nothing here is trusted: the seed is verified like any candidate, and
-learning starts from it where it fails.
+ratio is kept. An ellipsoid round the origin holds -x with x: where I lies on one side
+and the unsafe set just as far on the other (a pendulum started at 0.5 rad that must not
+reach -0.5), none fits, and with inputs the ellipsoid is moved towards I, round a point
+c of G that the controller's bias makes the closed loop's equilibrium
+(V = (x - c)^T P (x - c) - level). Nothing here is trusted: the seed is verified like
+any candidate, and learning starts from it where it fails.
 """
 from __future__ import annotations
 
@@ -46,28 +50,77 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
     if operating is None or not _origin_in_goal(plan):
         return []
     rng = np.random.default_rng(plan.options.seed)
-    discrete = plan.spec.time is TimeDomain.DISCRETE
-    floor = functools.partial(boundary_floor, region=plan.spec.property.role("safe"),
-                              centre=np.zeros(len(plan.states)))
     boundary = samples.get("boundary")
     if boundary is None:  # discrete time has no condition on ∂S; the ellipsoid must fit
         boundary = _boundary_samples(plan, rng)
+    found = _fitting(plan, networks, samples, boundary, np.zeros(len(plan.states)),
+                     operating, rng)
+    for centre in ([] if found or controller is None or _zero_at_origin(networks, controller)
+                   else _goal_centres(plan, samples.get("initial"))):
+        shifted = operating_point(plan.spec, centre)
+        if shifted is not None:
+            found = _fitting(plan, networks, samples, boundary, centre, shifted, rng)
+        if found:
+            break
+    found.sort(key=lambda fit: fit[0], reverse=True)
+    return [(True, _setter(networks, controller, v_part, b_part, K, operating, centre))
+            for _, v_part, b_part, K, operating, centre in found]
+
+
+def _fitting(plan, networks: dict, samples: dict, boundary, centre, operating, rng) -> list:
+    """(rank, V's (P, level), B's part or None, K, u*, c) of each closed loop at c whose
+    ellipsoid round c holds the sampled I and misses the sampled boundary of S."""
+    discrete = plan.spec.time is TimeDomain.DISCRETE
+    controlled = plan.controller is not None
+    floor = functools.partial(boundary_floor, region=plan.spec.property.role("safe"),
+                              centre=centre)
+    shifted = {k: (None if v is None else as_array(v) - centre) for k, v in samples.items()}
     found = []
-    for A, K in lqr_gains(plan.spec, controller is not None, operating, rng):
-        barrier = _barrier_part(A, discrete, samples) if "B" in networks else None
-        for ratio, P, level in separations(A, discrete, samples.get("initial"), boundary,
-                                           floor=floor):
+    for A, K in lqr_gains(plan.spec, controlled, operating, rng, centre if centre.any()
+                          else None):
+        barrier = _barrier_part(A, discrete, shifted) if "B" in networks else None
+        for ratio, P, level in separations(A, discrete, shifted.get("initial"),
+                                           boundary - centre, floor=floor):
             if ratio < MIN_RATIO:
                 continue
-            scale = _scale(P, A, discrete, level, samples.get("decrease"))
+            scale = _scale(P, A, discrete, level, shifted.get("decrease"))
             # where no quadratic B separates G from D \ F, V and the controller are
             # still seeded and B is left to learning: such seeds come last
             rank = (barrier is not None or "B" not in networks,
                     ratio if barrier is None else min(ratio, barrier[0]))
-            found.append((rank, (scale * P, scale * level), barrier, K))
-    found.sort(key=lambda fit: fit[0], reverse=True)
-    return [(True, _setter(networks, controller, v_part, b_part, K, operating))
-            for _, v_part, b_part, K in found]
+            found.append((rank, (scale * P, scale * level), barrier, K, operating, centre))
+    return found
+
+
+CENTRE_SHARES = (0.5, 0.25)  # of G's extent from the origin towards I, in turn
+
+
+def _goal_centres(plan, initial) -> list[np.ndarray]:
+    """Points of G on the segment from the origin towards the middle of I (of its box:
+    the samples' mean has stray components, and a pendulum's state with a velocity is no
+    equilibrium for any input), at CENTRE_SHARES of the distance to G's boundary there."""
+    box = plan.spec.property.role("initial").bounding_box()
+    if box is not None:
+        towards = (np.asarray(box[0], dtype=float) + np.asarray(box[1], dtype=float)) / 2
+    elif initial is not None and len(initial):
+        towards = as_array(initial).mean(axis=0)
+    else:
+        return []
+    if not np.linalg.norm(towards):
+        return []
+    goal = plan.spec.property.role("goal") if plan.spec.property.form != \
+        "reach and stay while avoid" else plan.spec.property.role("final")
+    steps = np.linspace(0.0, 1.0, 101)[:, None] * towards
+    inside = holds(goal.contains_formula(plan.states), state_env(plan.states, steps),
+                   len(steps))
+    extent = int(np.argmin(inside)) if not inside.all() else len(steps)
+    return [steps[int(share * (extent - 1))] for share in CENTRE_SHARES if extent > 2]
+
+
+def _zero_at_origin(networks: dict, controller) -> bool:
+    """Whether a network cannot hold a centre (no biases)."""
+    return controller.zero_at_origin or any(
+        networks[name].linears[0].bias is None for name in ("V", "B") if name in networks)
 
 
 def _boundary_samples(plan, rng: np.random.Generator, count: int = 1000) -> np.ndarray:
@@ -79,13 +132,15 @@ def _boundary_samples(plan, rng: np.random.Generator, count: int = 1000) -> np.n
     return as_array(points)
 
 
-def _setter(networks, controller, v_part, b_part, K, operating):
+def _setter(networks, controller, v_part, b_part, K, operating, centre):
+    at = centre if centre.any() else None
+
     def set_seed() -> None:
-        set_quadratic(networks["V"], *v_part)
+        set_quadratic(networks["V"], *v_part, centre=at)
         if b_part is not None:
-            set_quadratic(networks["B"], *b_part[1:])
+            set_quadratic(networks["B"], *b_part[1:], centre=at)
         if controller is not None:
-            set_linear(controller, -K, operating)
+            set_linear(controller, -K, operating + K @ centre)
     return set_seed
 
 
