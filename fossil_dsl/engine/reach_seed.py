@@ -80,7 +80,7 @@ def _fitting(plan, networks: dict, samples: dict, boundary, centre, operating, r
                           else None):
         barrier = _barrier_part(A, discrete, shifted) if "B" in networks else None
         for ratio, P, level in separations(A, discrete, shifted.get("initial"),
-                                           boundary - centre, floor=floor):
+                                           as_array(boundary) - centre, floor=floor):
             if ratio < MIN_RATIO:
                 continue
             scale = _scale(P, A, discrete, level, shifted.get("decrease"))
