@@ -38,6 +38,17 @@ def lqr_gains(spec, controlled: bool, operating, rng, state=None):
             yield found
 
 
+def initial_middle(spec, inside) -> np.ndarray | None:
+    """The middle of I's bounding box, else the mean of the points sampled in I (None
+    where there are none)."""
+    box = spec.property.role("initial").bounding_box()
+    if box is not None:
+        return (np.asarray(box[0], dtype=float) + np.asarray(box[1], dtype=float)) / 2
+    if inside is None or not len(inside):
+        return None
+    return as_array(inside).mean(axis=0)
+
+
 def separations(A: np.ndarray, discrete: bool, inside, outside, shapes=None, floor=None,
                 ceiling=None):
     """(ratio, P, level) of the Lyapunov matrix for Q = I and of the one that separates

@@ -29,7 +29,8 @@ from fossil_dsl.engine.linear import (as_array, holds_a_quadratic, is_linear,
                                       operating_point, quadratic_values, set_linear,
                                       set_quadratic)
 from fossil_dsl.engine.sampling import sample
-from fossil_dsl.engine.quadratic_shapes import boundary_floor, lqr_gains, separations
+from fossil_dsl.engine.quadratic_shapes import (boundary_floor, initial_middle, lqr_gains,
+                                               separations)
 from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.rwa import GAMMA
@@ -99,17 +100,10 @@ def _goal_centres(plan, initial) -> list[np.ndarray]:
     """Points of G on the segment from the origin towards the middle of I (of its box:
     the samples' mean has stray components, and a pendulum's state with a velocity is no
     equilibrium for any input), at CENTRE_SHARES of the distance to G's boundary there."""
-    box = plan.spec.property.role("initial").bounding_box()
-    if box is not None:
-        towards = (np.asarray(box[0], dtype=float) + np.asarray(box[1], dtype=float)) / 2
-    elif initial is not None and len(initial):
-        towards = as_array(initial).mean(axis=0)
-    else:
+    towards = initial_middle(plan.spec, initial)
+    if towards is None or not np.linalg.norm(towards):
         return []
-    if not np.linalg.norm(towards):
-        return []
-    goal = plan.spec.property.role("goal") if plan.spec.property.form != \
-        "reach and stay while avoid" else plan.spec.property.role("final")
+    goal = _goal(plan)
     steps = np.linspace(0.0, 1.0, 101)[:, None] * towards
     inside = holds(goal.contains_formula(plan.states), state_env(plan.states, steps),
                    len(steps))
@@ -153,11 +147,16 @@ def _fits(plan, networks: dict, controller) -> bool:
     return controller is None or is_linear(controller, len(plan.controller.inputs))
 
 
+def _goal(plan):
+    """The set V must reach (the final set of a reach-and-stay property)."""
+    prop = plan.spec.property
+    return prop.role("final") if prop.form == "reach and stay while avoid" \
+        else prop.role("goal")
+
+
 def _origin_in_goal(plan) -> bool:
     """Whether the origin lies in the set V must reach (where V need not decrease)."""
-    prop = plan.spec.property
-    goal = prop.role("goal") if prop.form != "reach and stay while avoid" \
-        else prop.role("final")
+    goal = _goal(plan)
     if goal is None:
         return False
     origin = np.zeros((1, len(plan.states)))

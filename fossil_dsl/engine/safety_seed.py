@@ -22,7 +22,8 @@ import numpy as np
 
 from fossil_dsl.engine.linear import (as_array, equilibrium, holds_a_quadratic, is_linear,
                                       operating_point, set_linear, set_quadratic)
-from fossil_dsl.engine.quadratic_shapes import (SHAPES, floor_outside, lqr_gains, separations,
+from fossil_dsl.engine.quadratic_shapes import (SHAPES, floor_outside, initial_middle, lqr_gains,
+                                               separations,
                                                set_ceiling, set_floor)
 from fossil_dsl.engine.sampling import sample
 from fossil_dsl.ir.sets import Boundary
@@ -111,10 +112,8 @@ def _equilibria(plan, network, controller, inside):
     spec = plan.spec
     n = len(plan.states)
     seen = []
-    box = spec.property.role("initial").bounding_box()
-    middle = inside.mean(axis=0) if box is None \
-        else (np.asarray(box[0], dtype=float) + np.asarray(box[1], dtype=float)) / 2
-    for start in (np.zeros(n), middle):
+    middle = initial_middle(spec, inside)
+    for start in [np.zeros(n)] + ([] if middle is None else [middle]):
         if controller is not None:
             centre, operating = start, operating_point(spec, start)
         else:

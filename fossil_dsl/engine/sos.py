@@ -79,16 +79,16 @@ def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
     variants = (plain,) if interval_products(plain) == plain else \
         (plain, interval_products(plain))
     too_large = set()  # the variants whose programs grew beyond MAX_VARIABLES
-    for degree, constraints, power in ((d, c, m) for d in DEGREES for c in range(len(variants))
-                                       for m in MARGIN_POWERS):
+    for degree, variant, power in ((d, v, m) for d in DEGREES for v in range(len(variants))
+                                   for m in MARGIN_POWERS):
         if time.monotonic() > deadline:
             return None
-        if constraints in too_large:
+        if variant in too_large:
             continue
-        program = _LyapunovProgram(len(plan.states), field, variants[constraints], degree,
+        program = _LyapunovProgram(len(plan.states), field, variants[variant], degree,
                                    power, plan.spec.time is TimeDomain.DISCRETE)
         if program.count > MAX_VARIABLES:
-            too_large.add(constraints)
+            too_large.add(variant)
             continue
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
