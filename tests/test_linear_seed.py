@@ -232,3 +232,27 @@ def test_the_first_controller_seed_is_lqrs_own_riccati_function():
     ratios = learner.networks["V"](points).detach().numpy().ravel() / np.einsum(
         "ni,ij,nj->n", points.numpy(), S, points.numpy())
     assert np.ptp(ratios) < 1e-3 * ratios.mean()  # V is a multiple of x^T S x
+
+
+ABS_DRAG = """\
+state th, w
+dynamics continuous {
+    th' = w
+    w' = -sin(th) - 0.5*w*abs(w) - 0.1*w
+}
+domain box([-2, -2], [2, 2])
+prove stable
+"""
+
+
+def test_a_term_whose_exact_derivative_is_undefined_at_the_origin_is_linearised():
+    """d(w |w|)/dw = |w| + w (w/|w|) is 0/0 at w = 0; the one-sided difference quotients
+    agree (0), so the linearisation exists (quadratic drag, probe52/m08)."""
+    A, _ = jacobians(fossil_dsl.loads(ABS_DRAG))
+    assert np.allclose(A, [[0, 1], [-1, -0.1]], atol=1e-5)
+
+
+def test_a_kink_at_the_origin_has_no_linearisation():
+    """-|x| has one-sided slopes -1 and 1 at 0: no Jacobian, no linear seed."""
+    kink = ABS_DRAG.replace("- 0.5*w*abs(w) - 0.1*w", "- abs(w)")
+    assert jacobians(fossil_dsl.loads(kink)) is None

@@ -1,10 +1,12 @@
 """The sum-of-squares attempt for reach-type properties (engine/sos_reach.py): V (and B)
 from a semidefinite program, with a controller fixed to an LQR gain where there are
 inputs, proved like any candidate."""
+import math
 import time
 from fractions import Fraction
 from pathlib import Path
 
+import numpy as np
 import pytest
 import sympy
 
@@ -226,3 +228,36 @@ def test_the_program_finds_nothing_for_a_false_reach_property_of_a_map(name):
     assert sos_reach.applies(plan)
     assert sos_reach.search(plan, time.monotonic() + 30) is None
     assert not fossil_dsl.synthesise(spec, seed=0, timeout=10).certified
+
+
+def test_reach_and_stay_with_a_controller_gets_a_quartic_v_and_its_level():
+    """probe52/m04, a hovering quadrotor's altitude (linear, u* = 9.81): I lies 1 below
+    F, the unsafe set 0.5 above, so no quadratic V round an equilibrium in F fits (its
+    sublevel set holds I's mirror image). The program finds a quartic V and β with
+    V < β round the equilibrium and V > β on F outside a ball: the kernel proves the
+    stay conditions with that β (learning's quadratic failed in 25 iterations)."""
+    spec = fossil_dsl.load(ROOT / "specs" / "probe52" / "m04_hover_rswa_ctrl.fsl")
+    plan = compile_spec(spec)
+    assert sos_reach.applies(plan)
+    finding = sos_reach.search(plan, time.monotonic() + 30)
+    assert finding is not None and finding.degree == 4 and "beta" in finding.levels
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+    V = result.sympy["V"]
+    w, z = sorted(V.free_symbols, key=str)
+    assert float(V.subs({z: -1, w: 0})) <= 0 < float(V.subs({z: 1, w: 0}))
+    # β lies between V at the equilibrium and V on ∂F (the circle of radius 0.2)
+    beta = float(result.levels["beta"])
+    circle = [float(V.subs({z: 0.2 * math.cos(t), w: 0.2 * math.sin(t)}))
+              for t in np.linspace(0, 2 * math.pi, 60)]
+    assert float(V.subs({z: 0, w: 0})) < beta < min(circle)
+
+
+@pytest.mark.parametrize("name", ["f06_rswa_leaves", "f15_drift_cannot_remain"])
+def test_the_program_finds_nothing_for_a_false_reach_and_stay_property(name):
+    spec = fossil_dsl.load(ROOT / "specs" / "false" / f"{name}.fsl")
+    plan = compile_spec(spec)
+    if sos_reach.applies(plan):
+        assert sos_reach.search(plan, time.monotonic() + 30) is None
+    assert not fossil_dsl.synthesise(spec, seed=0, timeout=20, max_iters=3).certified

@@ -1,33 +1,30 @@
-"""What a run tries, in order: a sum-of-squares Lyapunov function where the system is
-polynomial (proved by sum-of-squares refutations of the kernel's obligations, or by the
-solvers like a given candidate), then the learning loop with the time left. Whatever is
-tried, the kernel judges the final formulas (and checks any refutation) alone."""
+"""What a run tries, in order: for `region: largest` a V shaped to the basin; for safety a
+conserved quantity's barrier, then one round a repelling equilibrium in U; a
+sum-of-squares certificate where the system is polynomial (each proved by proving.py),
+then the learning loop with the time left. Whatever is tried, the kernel judges the final
+formulas (and checks any refutation) alone."""
 from __future__ import annotations
 
+import itertools
 import time
 
 import numpy as np
 from dataclasses import replace
 
-from fossil_dsl.engine import basin, first_integral, sos, sos_reach, torch_import
+from fossil_dsl.engine import basin, first_integral, repelling, sos, sos_reach, torch_import
 from fossil_dsl.engine.given import verifier_only
+from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, only_function, prove_found,
+                                       verify_given)
 from fossil_dsl.engine.sos_barrier import barrier
-from fossil_dsl.engine.loop import (Cegis, CegisOutcome, IterationRecord, Verdict, as_listener,
-                                    failure_reason)
-from fossil_dsl.kernel import Claim, list_obligations
-from fossil_dsl.kernel.prove import SUM_OF_SQUARES
+from fossil_dsl.engine.loop import Cegis, CegisOutcome, as_listener
+from fossil_dsl.kernel import Claim
 from fossil_dsl.kernel.rules import lemma_radius
 from fossil_dsl.plan.compile import Plan, origin_radius, with_conditions
-from fossil_dsl.solvers.api import Backend, Status
-from fossil_dsl.solvers.sos_refutation import refute
+from fossil_dsl.solvers.api import Backend
 
 BASIN_SHARE = 0.3  # of the run's time, at most, for shaping V to the basin (region: largest)
 SOS_SHARE = 0.25  # of the run's time, at most, for the sum-of-squares attempt
 SOS_SECONDS = 30.0  # and never more than this
-# per solver query on the sum-of-squares candidate, where no refutation settles a
-# condition: a candidate the solvers cannot prove at once is left to learning (bb25: an
-# interval proof of 50 s against 6 s of learning)
-SOS_QUERY_SECONDS = 5.0
 # the shaped V has no cheaper alternative in a `region: largest` run (a degree-8 decrease
 # condition near the excluded ball takes the interval procedure 5-20 s)
 BASIN_QUERY_SECONDS = 30.0
@@ -37,6 +34,7 @@ BASIN_QUERY_SECONDS = 30.0
 # floor keeps hopeless ones short (g04: its quartic V's refutations took 40 s and failed;
 # a quadratic V's are found in well under a second)
 REACH_REFUTING_SECONDS = 5.0
+REPELLING_TRIES = 2  # barriers round a repelling equilibrium proved, at most
 CONSERVED_REFINEMENTS = 3  # conserved-quantity barriers chosen again with counterexamples
 BASIN_TOTAL_SHARE = 0.5  # of the run's time, at most, for the whole attempt
 BASIN_REFINEMENTS = 3  # programs solved again with the solvers' counterexamples
@@ -49,26 +47,16 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
     listener = as_listener(progress)
     deadline = time.monotonic() + plan.options.timeout
     notes = []
-    if backend is not None and basin.applies(plan):
-        found, note = _shaped_to_basin(plan, backend, listener, deadline)
-        if found is not None:
-            return found
-        notes.append(note)
-    if backend is not None and first_integral.applies(plan):
-        found, note = _conserved(plan, backend, listener, deadline)
-        if found is not None:
-            return found
-        notes.append(note)
-    if backend is not None and sos.applies(plan):
-        found, note = _sum_of_squares(plan, backend, listener, deadline)
-        if found is not None:
-            return found
-        notes.append(note)
-    if backend is not None and sos_reach.applies(plan):
-        found, note = _reach_sum_of_squares(plan, backend, listener, deadline)
-        if found is not None:
-            return found
-        notes.append(note)
+    for applies, attempt in ((basin.applies, _shaped_to_basin),
+                             (first_integral.applies, _conserved),
+                             (repelling.applies, _repelling),
+                             (sos.applies, _sum_of_squares),
+                             (sos_reach.applies, _reach_sum_of_squares)):
+        if backend is not None and applies(plan):
+            found, note = attempt(plan, backend, listener, deadline)
+            if found is not None:
+                return found
+            notes.append(note)
     note = "; ".join(n for n in notes if n)
     deadline += _learning_imported(plan)
     outcome = Cegis(plan, backend, listener, deadline).run()
@@ -133,9 +121,10 @@ def _shaped_proof(plan: Plan, finding, backend: Backend, listener, deadline: flo
     lemma = _ball_left_out(plan, finding, radius)
     for attempt in (lemma,) if lemma.origin_radius == radius else \
             (lemma, replace(plan, origin_radius=radius)):
-        given, outcome = _given(attempt, backend, listener, deadline,
-                                _only(attempt, finding.formula), BASIN_QUERY_SECONDS,
-                                time.monotonic() + BASIN_REFUTING_SECONDS)
+        given, outcome = verify_given(attempt, backend, listener, deadline,
+                                      only_function(attempt, finding.formula),
+                                      BASIN_QUERY_SECONDS,
+                                      time.monotonic() + BASIN_REFUTING_SECONDS)
         if outcome.certified or time.monotonic() > deadline:
             break
     return given, outcome
@@ -151,6 +140,18 @@ def _ball_left_out(plan: Plan, finding, radius) -> Plan:
     return replace(plan, origin_radius=lemma_radius(claim) or radius)
 
 
+def _repelling(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with B given, certified outcome) or None, what happened)."""
+    listener.phase(0, "barrier round a repelling equilibrium")
+    note = ""  # (none in U: nothing to say)
+    for finding in itertools.islice(repelling.candidates(plan), REPELLING_TRIES):
+        found, note = prove_found(plan, backend, listener, deadline, finding,
+                                  REACH_REFUTING_SECONDS)
+        if found is not None:
+            return found, ""
+    return None, note
+
+
 def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
     """((plan with V given, certified outcome) or None, what happened)."""
     listener.phase(0, "sum-of-squares program")
@@ -159,11 +160,11 @@ def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
     finding = search(plan, time.monotonic() + budget)
     if finding is None:
         return None, "no sum-of-squares certificate found"
-    found, note = _proved(plan, backend, listener, deadline, finding, budget)
+    found, note = prove_found(plan, backend, listener, deadline, finding, budget)
     ball = _lemma_ball(plan, finding) if found is None else None
     if ball is not None:  # the solvers' "counterexamples" were next to the origin
-        found, note = _proved(ball, backend, listener, deadline, finding, budget,
-                              BASIN_QUERY_SECONDS)
+        found, note = prove_found(ball, backend, listener, deadline, finding, budget,
+                                  BASIN_QUERY_SECONDS)
     return found, note
 
 
@@ -191,10 +192,9 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
     finding = sos_reach.search(plan, time.monotonic() + budget)
     if finding is None:
         return None, "no sum-of-squares reach certificate found"
-    prepare = (lambda cegis: _controller_set(cegis, finding)) if finding.controller else None
     refuting = max(REACH_REFUTING_SECONDS, 2 * finding.seconds)
-    return _proved(plan, backend, listener, deadline, finding, refuting,
-                   formulas=finding.formulas, prepare=prepare)
+    return prove_found(plan, backend, listener, deadline, finding, refuting,
+                       formulas=finding.formulas, prepare=lambda cegis: _set_up(cegis, finding))
 
 
 def _conserved(plan: Plan, backend: Backend, listener, deadline: float):
@@ -213,9 +213,10 @@ def _conserved(plan: Plan, backend: Backend, listener, deadline: float):
         prepare = (lambda cegis: _controller_set(cegis, finding)) if finding.controller \
             else None
         try:
-            given, outcome = _given(variant, backend, listener, deadline,
-                                    _only(variant, finding.formula), SOS_QUERY_SECONDS,
-                                    time.monotonic() + REACH_REFUTING_SECONDS, prepare)
+            given, outcome = verify_given(variant, backend, listener, deadline,
+                                          only_function(variant, finding.formula),
+                                          SOS_QUERY_SECONDS,
+                                          time.monotonic() + REACH_REFUTING_SECONDS, prepare)
         except NotSetUp as exc:
             return None, f"{finding.describe()}: {exc}"
         if outcome.certified:
@@ -231,6 +232,13 @@ def _conserved(plan: Plan, backend: Backend, listener, deadline: float):
     return None, note
 
 
+def _set_up(cegis: Cegis, finding) -> None:
+    """The controller and the levels (RSWA's β) the functions were found for."""
+    if finding.controller:
+        _controller_set(cegis, finding)
+    cegis.learner.fixed_levels = dict(finding.levels)
+
+
 def _controller_set(cegis: Cegis, finding) -> None:
     """Sets the loop's controller network to the gain the functions were found for;
     raises NotSetUp unless its exact formulas are the ones the program used."""
@@ -242,104 +250,3 @@ def _controller_set(cegis: Cegis, finding) -> None:
     if not all(sos_reach.same_polynomial(formula, finding.controller[u], states)
                for u, formula in zip(cegis.plan.controller.inputs, exact)):
         raise NotSetUp("the controller network cannot hold its gain")
-
-
-class NotSetUp(Exception):
-    """A found function's companion (a controller) could not be given to the loop."""
-
-
-def _verified_once(cegis: Cegis) -> CegisOutcome:
-    """The loop's candidate verified as it is (nothing is learned)."""
-    candidate = cegis.exact_candidate()
-    verdicts, queries, seconds = cegis.verify(candidate, 1)
-    record = IterationRecord(1, 0.0, verdicts, 0.0, seconds)
-    cegis.listener.finished(record)
-    certified = all(v.status is Status.UNSAT for v in verdicts)
-    return CegisOutcome(certified, "every condition proved" if certified else
-                        failure_reason(verdicts), candidate, queries, tuple(verdicts),
-                        (record,), 0.0, seconds, cegis.networks)
-
-
-def _proved(plan: Plan, backend: Backend, listener, deadline: float, finding,
-            refuting_seconds: float, query_seconds: float = SOS_QUERY_SECONDS,
-            formulas: dict | None = None, prepare=None):
-    """((plan with the function given, certified outcome) or None, what happened)."""
-    try:
-        given, outcome = _given(plan, backend, listener, deadline,
-                                formulas or _only(plan, finding.formula), query_seconds,
-                                time.monotonic() + refuting_seconds, prepare)
-    except NotSetUp as exc:
-        return None, f"{finding.describe()}: {exc}"
-    if not outcome.certified:
-        return None, f"{finding.describe()}: not proved: {outcome.reason}"
-    return (given, replace(outcome, strategy=finding.describe())), ""
-
-
-def _given(plan: Plan, backend: Backend, listener, deadline: float, formulas,
-           query_seconds: float, refuting_until: float | None = None, prepare=None):
-    """The plan with the found functions (name -> formula) as its candidates, and its
-    outcome: proved by refutations of the
-    kernel's obligations where they settle every condition, else by the solvers; the
-    candidate is verified once (nothing is learned). `prepare(cegis)` sets up the rest
-    of the loop (a controller), raising NotSetUp where it cannot."""
-    given = replace(plan, functions=tuple(replace(f, candidate=formulas[f.name])
-                                          for f in plan.functions))
-    options = replace(plan.options, query_timeout=min(plan.options.query_timeout,
-                                                      query_seconds))
-    cegis = Cegis(replace(given, options=options), backend, listener, deadline)
-    if prepare is not None:
-        prepare(cegis)
-    listener.phase(0, "sum-of-squares refutations")
-    outcome = _refuted(given, cegis, refuting_until or deadline)
-    listener.finished(outcome.history[-1])
-    if not outcome.certified:
-        outcome = _merged(_verified_once(cegis), outcome.refutations)
-    return given, outcome
-
-
-def _only(plan: Plan, formula) -> dict:
-    """The formula as the plan's one function (a Lyapunov V, a barrier B)."""
-    return {f.name: formula for f in plan.functions}
-
-
-def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
-    """Sum-of-squares refutations of the kernel's obligations for the candidate, found
-    numerically and rounded (the kernel checks them exactly); certified here when they
-    settle every condition."""
-    started = time.monotonic()
-    candidate = cegis.exact_candidate()
-    claim = Claim(plan.spec, dict(candidate.formulas), {}, dict(candidate.levels),
-                  plan.origin_radius)
-    refutations = {}
-    for obligation in list_obligations(claim):
-        found = refute(obligation.query, plan.states, deadline)
-        if found is not None:
-            refutations[obligation.name] = found
-    verdicts = _settled(tuple(Verdict(c.name, Status.UNKNOWN, "no refutation found")
-                              for c in plan.conditions), refutations)
-    certified = all(v.status is Status.UNSAT for v in verdicts)
-    seconds = time.monotonic() - started
-    return CegisOutcome(certified, "every condition proved" if certified else
-                        "not every condition has a refutation", candidate, {}, verdicts,
-                        (IterationRecord(1, 0.0, verdicts, 0.0, seconds),), 0.0, seconds, {},
-                        refutations=refutations)
-
-
-def _merged(outcome: CegisOutcome, refutations: dict) -> CegisOutcome:
-    """The solvers' verdicts, with the conditions they did not prove settled by a
-    refutation where there is one. (A "counterexample" of a delta-decision verifier near
-    the origin is no obstacle: a refutation that checks shows there is none; where there
-    is a true one, no refutation exists.)"""
-    verdicts = _settled(outcome.verdicts, refutations)
-    certified = not outcome.interrupted and all(v.status is Status.UNSAT for v in verdicts)
-    return replace(outcome, certified=certified, verdicts=verdicts, refutations=refutations,
-                   reason="every condition proved" if certified else outcome.reason)
-
-
-def _settled(verdicts, refutations: dict) -> tuple[Verdict, ...]:
-    """Each condition not proved yet that a refutation of the kernel's obligation for it
-    settles, as proved by it."""
-    return tuple(replace(v, status=Status.UNSAT, solver=SUM_OF_SQUARES, reason="",
-                         counterexample=None)
-                 if v.status is not Status.UNSAT and f"condition:{v.condition}" in refutations
-                 else v for v in verdicts)

@@ -27,12 +27,17 @@ class GivenFunctions:
         self.digits = plan.options.digits
         self.candidates = {f.name: f.candidate for f in plan.functions}
         self.samples = initial_samples(plan, np.random.default_rng(plan.options.seed))
+        self.fixed_levels = {}  # name -> value a found candidate was made for
 
     def levels(self) -> dict[str, float]:
-        return {level.name: float(level_value(
-            self.values(level.function, level.above),
-            self.values(level.function, level.below),
-            self.plan.options.margin)) for level in self.plan.levels}
+        return {level.name: self._level(level) for level in self.plan.levels}
+
+    def _level(self, level) -> float:
+        if level.name in self.fixed_levels:
+            return float(self.fixed_levels[level.name])
+        return float(level_value(self.values(level.function, level.above),
+                                 self.values(level.function, level.below),
+                                 self.plan.options.margin))
 
     def values(self, function: str, condition: str | None) -> np.ndarray | None:
         if condition is None:

@@ -56,6 +56,7 @@ class Learner(ViolationSearch):
                                       outputs=len(c.inputs), centre=centre)
         self.conditions = {c.name: c for c in plan.conditions}
         self.digits = plan.options.digits  # of the last rounding
+        self.fixed_levels = {}  # name -> value a found candidate was made for
         # each condition's placeholders, collected once (walking its formulas each
         # training step cost a tenth of the step)
         self._placeholders = {c.name: placeholders(c) for c in plan.conditions}
@@ -184,6 +185,8 @@ class Learner(ViolationSearch):
         is a tensor that keeps its gradient: a loss that pushes V below it then also
         pushes that smallest value up, instead of dragging V and the level down
         together for ever."""
+        if level.name in self.fixed_levels:
+            return torch.tensor(float(self.fixed_levels[level.name]), dtype=torch.float64)
         if level.above is None:  # just over the largest value `below`, with its gradient
             below = self.function(level.function, self.samples[level.below])
             return level_value(None, below, self.plan.options.margin)

@@ -40,7 +40,7 @@ def jacobians(spec: CheckedSpec, inputs=None, state=None) -> tuple[np.ndarray, n
     or None where a derivative is not a finite number there."""
     point = _point(spec, inputs, state)
     try:
-        rows = [[_value_at(derivative(f, v), point) for v in (*spec.states, *spec.inputs)]
+        rows = [[_partial(f, v, point) for v in (*spec.states, *spec.inputs)]
                 for f in spec.dynamics]
     except (E.ExprError, ValueError, ZeroDivisionError):
         return None
@@ -49,6 +49,28 @@ def jacobians(spec: CheckedSpec, inputs=None, state=None) -> tuple[np.ndarray, n
         return None
     n = len(spec.states)
     return matrix[:, :n], matrix[:, n:]
+
+
+def _partial(f: E.Expr, var: str, point: dict) -> float:
+    """df/dvar at the point: the exact derivative's value, or where that is undefined
+    there (w |w| gives |w| + w (w/|w|), 0/0 at w = 0) the two one-sided difference
+    quotients where they agree (the linearisation only seeds candidates)."""
+    try:
+        return _value_at(derivative(f, var), point)
+    except (E.ExprError, ValueError, ZeroDivisionError):
+        pass
+    here = float(point[var].value)
+    at = lambda x: _value_at(f, {**point, var: E.Num(Fraction(x))})  # noqa: E731
+    centre = at(here)
+    right = (at(here + STEP) - centre) / STEP
+    left = (centre - at(here - STEP)) / STEP
+    if abs(right - left) > SIDES_AGREE * (1 + abs(right)):
+        raise ValueError(f"no derivative in {var} at the point")
+    return (right + left) / 2
+
+
+STEP = 1e-7  # of the one-sided difference quotients
+SIDES_AGREE = 1e-4
 
 
 def _point(spec: CheckedSpec, inputs=None, state=None) -> dict[str, E.Expr]:

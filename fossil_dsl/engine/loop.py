@@ -264,7 +264,8 @@ class Cegis:
                                   learner.controller.formulas(self.states, digits)))
         closed_loop = tuple(traversal.substitute(f, controller) for f in self.plan.spec.dynamics)
         changes = {name: self.change(formula, closed_loop) for name, formula in formulas.items()}
-        levels = {name: rational(value, digits) for name, value in learner.levels().items()}
+        levels = {name: Fraction(learner.fixed_levels[name]) if name in learner.fixed_levels
+                  else rational(value, digits) for name, value in learner.levels().items()}
         next_state = dict(zip(self.states, closed_loop)) \
             if self.plan.spec.time is TimeDomain.DISCRETE else {}
         return ExactCandidate(formulas, changes, controller, levels, digits, next_state)

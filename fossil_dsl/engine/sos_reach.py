@@ -45,7 +45,7 @@ from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.gram_rounding import decimal
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 
-FORMS = ("reach while avoid", "reach", "reach-avoid-remain")
+FORMS = ("reach while avoid", "reach", "reach-avoid-remain", "reach and stay while avoid")
 DISCRETE_FORMS = ("reach while avoid", "reach")
 HALF_DEGREES = (1, 2)  # V of degree 2, then 4
 DECIMALS = 6  # kept of V's coefficients
@@ -67,6 +67,7 @@ class ReachFinding:
     degree: int
     margin: float
     seconds: float
+    levels: dict  # name -> Fraction (RSWA's β), fixed for the proof
 
     def describe(self) -> str:
         control = " for an LQR gain of the linearisation" if self.controller else ""
@@ -114,10 +115,10 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
             continue
         found = _functions(len(states), field, denominator, pieces, deadline, discrete)
         if found is not None:
-            formulas, degree, margin = found
+            formulas, levels, degree, margin = found
             return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
                                 controller, gain, operating, degree, margin,
-                                time.monotonic() - started)
+                                time.monotonic() - started, levels)
     return None
 
 
@@ -178,10 +179,14 @@ class _Pieces:
         else:  # S is a set of its own (`S until G`)
             outside_safe = self.outside(prop.role("safe"), states)
         self.boundary = self.faces() + outside_safe
-        self.outside_goal = self.outside(prop.role("goal"), states)
-        self.goal = interval_products(_constraints(prop.role("goal"), states))
+        staying = prop.form == "reach and stay while avoid"
+        goal = prop.role("final") if staying else prop.role("goal")
+        self.outside_goal = self.outside(goal, states)
+        self.goal = interval_products(_constraints(goal, states))
         final = prop.role("final")
-        self.outside_final = self.outside(final, states) if final is not None else None
+        self.outside_final = self.outside(final, states) if final is not None and \
+            not staying else None
+        self.stay = _StayPieces(self, goal, plan) if staying else None
 
     def faces(self) -> list[list[P.Polynomial]]:
         """Each face {g = 0} of the domain, within the domain."""
@@ -192,6 +197,48 @@ class _Pieces:
         """D outside the region's interior: {g <= 0} within D, one piece per g."""
         return [[P.scale(g, -1)] + interval_products(self.domain)
                 for g in _constraints(region, states)]
+
+
+class _StayPieces:
+    """For RSWA, balls round the origin (the closed loop's equilibrium) inside F, of a
+    quarter and a half of the sampled distance to F's boundary: V < β on the inner
+    one, V > β on F outside the outer one, and V decreases on D outside the inner one.
+    With β fixed, F ∩ {V >= β} then lies where V decreases and ∂F has V > β."""
+
+    def __init__(self, pieces: _Pieces, final, plan: Plan):
+        states = plan.states
+        reach = _distance_to_boundary(final, plan)
+        if reach is None:
+            raise Inexact("the origin is not inside F")
+        inner, outer = (_ball(states, reach / 4), _ball(states, reach / 2))
+        self.inner = [inner]
+        self.decrease = [[P.scale(inner, -1)] + interval_products(pieces.domain)]
+        self.above = [pieces.goal + [P.scale(outer, -1)]]
+
+
+def _ball(states, radius: float) -> P.Polynomial:
+    """r^2 - |x|^2 (>= 0 on the ball), with r^2 a short rational."""
+    square = Fraction(radius ** 2).limit_denominator(10 ** 6)
+    return P.add(P.constant(square, len(states)),
+                 *({tuple(2 * (k == i) for k in range(len(states))): Fraction(-1)}
+                   for i in range(len(states))))
+
+
+def _distance_to_boundary(region, plan: Plan) -> float | None:
+    """The smallest |x| over samples of the region's boundary, where the origin lies in
+    the region (else None)."""
+    from fossil_dsl.engine.evaluate import holds, state_env
+    from fossil_dsl.engine.sampling import sample
+    from fossil_dsl.ir.sets import Boundary
+    states = plan.states
+    origin = np.zeros((1, len(states)))
+    if not holds(region.contains_formula(states), state_env(states, origin), 1)[0]:
+        return None
+    points = np.asarray(sample(Boundary(region), states, 2000,
+                               np.random.default_rng(plan.options.seed),
+                               plan.spec.domain.bounding_box()), dtype=float)
+    distance = float(np.linalg.norm(points, axis=1).min()) if len(points) else 0.0
+    return distance if distance > 0 else None
 
 
 def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
@@ -214,7 +261,7 @@ def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
             found = {"V": program.exact_v(x)}
             if b is not None:
                 found["B"] = b
-            return found, 2 * half, float(x[program.margin])
+            return found, program.levels(x), 2 * half, float(x[program.margin])
     return None
 
 
@@ -249,8 +296,22 @@ class _ReachProgram(Program):
         decrease = [(v, P.scale(P.change(t, field, discrete), -1))
                     for v, t in zip(self.coefficients, terms)]
         # grad V . N <= -γ Q, that is dV/dt <= -γ (for a map V(f(x)) - V(x) <= -γ)
-        for piece in pieces.outside_goal:
+        stay = pieces.stay
+        for piece in pieces.outside_goal if stay is None else stay.decrease:
             self.require(decrease, piece, P.scale(denominator, -GAMMA))
+        self.beta = None
+        if stay is not None:  # V - β > 0 on F outside the outer ball, < 0 on the inner
+            self.beta = self.scalar()
+            self.at_most += [({self.beta: 1.0}, BOUND), ({self.beta: -1.0}, BOUND)]
+            one = P.constant(1, n)
+            for piece in stay.above:
+                self.require(list(zip(self.coefficients, terms)) + [(self.beta, P.scale(one, -1))],
+                             piece)
+            self.require(negated + [(self.beta, one)], stay.inner)
+
+    def levels(self, x) -> dict:
+        """β (RSWA) as a short decimal, else nothing."""
+        return {} if self.beta is None else {"beta": decimal(x[self.beta], DECIMALS)}
 
     def require(self, terms, constraints, constant=None) -> None:
         """sum of terms (+ constant) - e = s + sum_i sigma_i g_i, as one identity."""

@@ -1,0 +1,121 @@
+"""Proving a function found by an attempt (a program's, a conserved quantity, a
+repelling equilibrium's barrier): sum-of-squares refutations of the kernel's obligations
+first, then one pass of the solvers for what they leave; nothing is learned."""
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+from fossil_dsl.engine.loop import Cegis, CegisOutcome, IterationRecord, Verdict, failure_reason
+from fossil_dsl.kernel import Claim, list_obligations
+from fossil_dsl.kernel.prove import SUM_OF_SQUARES
+from fossil_dsl.plan.compile import Plan
+from fossil_dsl.solvers.api import Backend, Status
+from fossil_dsl.solvers.sos_refutation import refute
+
+# per solver query on a found candidate, where no refutation settles a condition: a
+# candidate the solvers cannot prove at once is left to learning (bb25: an interval
+# proof of 50 s against 6 s of learning)
+SOS_QUERY_SECONDS = 5.0
+
+
+class NotSetUp(Exception):
+    """A found function's companion (a controller) could not be given to the loop."""
+
+
+def _verified_once(cegis: Cegis) -> CegisOutcome:
+    """The loop's candidate verified as it is (nothing is learned)."""
+    candidate = cegis.exact_candidate()
+    verdicts, queries, seconds = cegis.verify(candidate, 1)
+    record = IterationRecord(1, 0.0, verdicts, 0.0, seconds)
+    cegis.listener.finished(record)
+    certified = all(v.status is Status.UNSAT for v in verdicts)
+    return CegisOutcome(certified, "every condition proved" if certified else
+                        failure_reason(verdicts), candidate, queries, tuple(verdicts),
+                        (record,), 0.0, seconds, cegis.networks)
+
+
+def prove_found(plan: Plan, backend: Backend, listener, deadline: float, finding,
+                refuting_seconds: float, query_seconds: float = SOS_QUERY_SECONDS,
+                formulas: dict | None = None, prepare=None):
+    """((plan with the function given, certified outcome) or None, what happened)."""
+    try:
+        given, outcome = verify_given(plan, backend, listener, deadline,
+                                      formulas or only_function(plan, finding.formula),
+                                      query_seconds, time.monotonic() + refuting_seconds,
+                                      prepare)
+    except NotSetUp as exc:
+        return None, f"{finding.describe()}: {exc}"
+    if not outcome.certified:
+        return None, f"{finding.describe()}: not proved: {outcome.reason}"
+    return (given, replace(outcome, strategy=finding.describe())), ""
+
+
+def verify_given(plan: Plan, backend: Backend, listener, deadline: float, formulas,
+                 query_seconds: float, refuting_until: float | None = None, prepare=None):
+    """The plan with the found functions (name -> formula) as its candidates, and its
+    outcome: proved by refutations of the kernel's obligations where they settle every
+    condition, else by the solvers; the
+    candidate is verified once (nothing is learned). `prepare(cegis)` sets up the rest
+    of the loop (a controller), raising NotSetUp where it cannot."""
+    given = replace(plan, functions=tuple(replace(f, candidate=formulas[f.name])
+                                          for f in plan.functions))
+    options = replace(plan.options, query_timeout=min(plan.options.query_timeout,
+                                                      query_seconds))
+    cegis = Cegis(replace(given, options=options), backend, listener, deadline)
+    if prepare is not None:
+        prepare(cegis)
+    listener.phase(0, "sum-of-squares refutations")
+    outcome = _refuted(given, cegis, refuting_until or deadline)
+    listener.finished(outcome.history[-1])
+    if not outcome.certified:
+        outcome = _merged(_verified_once(cegis), outcome.refutations)
+    return given, outcome
+
+
+def only_function(plan: Plan, formula) -> dict:
+    """The formula as the plan's one function (a Lyapunov V, a barrier B)."""
+    return {f.name: formula for f in plan.functions}
+
+
+def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
+    """Sum-of-squares refutations of the kernel's obligations for the candidate, found
+    numerically and rounded (the kernel checks them exactly); certified here when they
+    settle every condition."""
+    started = time.monotonic()
+    candidate = cegis.exact_candidate()
+    claim = Claim(plan.spec, dict(candidate.formulas), {}, dict(candidate.levels),
+                  plan.origin_radius)
+    refutations = {}
+    for obligation in list_obligations(claim):
+        found = refute(obligation.query, plan.states, deadline)
+        if found is not None:
+            refutations[obligation.name] = found
+    verdicts = _settled(tuple(Verdict(c.name, Status.UNKNOWN, "no refutation found")
+                              for c in plan.conditions), refutations)
+    certified = all(v.status is Status.UNSAT for v in verdicts)
+    seconds = time.monotonic() - started
+    return CegisOutcome(certified, "every condition proved" if certified else
+                        "not every condition has a refutation", candidate, {}, verdicts,
+                        (IterationRecord(1, 0.0, verdicts, 0.0, seconds),), 0.0, seconds, {},
+                        refutations=refutations)
+
+
+def _merged(outcome: CegisOutcome, refutations: dict) -> CegisOutcome:
+    """The solvers' verdicts, with the conditions they did not prove settled by a
+    refutation where there is one. (A "counterexample" of a delta-decision verifier near
+    the origin is no obstacle: a refutation that checks shows there is none; where there
+    is a true one, no refutation exists.)"""
+    verdicts = _settled(outcome.verdicts, refutations)
+    certified = not outcome.interrupted and all(v.status is Status.UNSAT for v in verdicts)
+    return replace(outcome, certified=certified, verdicts=verdicts, refutations=refutations,
+                   reason="every condition proved" if certified else outcome.reason)
+
+
+def _settled(verdicts, refutations: dict) -> tuple[Verdict, ...]:
+    """Each condition not proved yet that a refutation of the kernel's obligation for it
+    settles, as proved by it."""
+    return tuple(replace(v, status=Status.UNSAT, solver=SUM_OF_SQUARES, reason="",
+                         counterexample=None)
+                 if v.status is not Status.UNSAT and f"condition:{v.condition}" in refutations
+                 else v for v in verdicts)
