@@ -33,6 +33,8 @@ STABLE_FORMS = ("stability", "stable while avoid") + ROA_FORMS
 LEVEL_POSITION = 0.25
 OPERATING_STEPS = 20
 MAX_CONDITION = 1e6  # a P this ill-conditioned would not survive rounding to decimals
+STEP = 1e-7  # of the one-sided difference quotients, where an exact derivative is 0/0
+SIDES_AGREE = 1e-4  # relative: the two quotients agree within this (a kink does not)
 
 
 def jacobians(spec: CheckedSpec, inputs=None, state=None) -> tuple[np.ndarray, np.ndarray] | None:
@@ -67,10 +69,6 @@ def _partial(f: E.Expr, var: str, point: dict) -> float:
     if abs(right - left) > SIDES_AGREE * (1 + abs(right)):
         raise ValueError(f"no derivative in {var} at the point")
     return (right + left) / 2
-
-
-STEP = 1e-7  # of the one-sided difference quotients
-SIDES_AGREE = 1e-4
 
 
 def _point(spec: CheckedSpec, inputs=None, state=None) -> dict[str, E.Expr]:

@@ -13,6 +13,7 @@ The formula is rounded to rationals and proved like any candidate: nothing is tr
 """
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 from fractions import Fraction
@@ -66,7 +67,8 @@ def candidates(plan: Plan):
         found = jacobians(spec, None, centre)
         if found is None or np.linalg.eigvals(found[0]).real.min() <= 0:
             continue
-        ceiling = lambda matrix: set_ceiling(matrix, spec.property.role("unsafe"), centre)  # noqa: E731
+        ceiling = functools.partial(set_ceiling, region=spec.property.role("unsafe"),
+                                    centre=centre)
         for _, matrix, level in separations(-found[0], False, unsafe - centre,
                                             initial - centre, ceiling=ceiling):
             yield RepellingFinding(_formula(matrix, level, centre, states), centre,
@@ -96,15 +98,11 @@ def _formula(matrix: np.ndarray, level: float, centre: np.ndarray, states) -> E.
     scale = np.abs(matrix).max()
     n = len(states)
     shifted = [P.add({tuple(int(k == i) for k in range(n)): Fraction(1)},
-                     P.constant(-_decimal(centre[i]), n)) for i in range(n)]
-    terms = [P.constant(_decimal(level / scale), n)]
+                     P.constant(-decimal(centre[i], DECIMALS), n)) for i in range(n)]
+    terms = [P.constant(decimal(level / scale, DECIMALS), n)]
     for i in range(n):
         for j in range(n):
-            weight = _decimal(matrix[i, j] / scale)
+            weight = decimal(matrix[i, j] / scale, DECIMALS)
             if weight:
                 terms.append(P.scale(P.multiply(shifted[i], shifted[j]), -weight))
     return P.to_expr(P.add(*terms), states)
-
-
-def _decimal(value: float) -> Fraction:
-    return decimal(value, DECIMALS)

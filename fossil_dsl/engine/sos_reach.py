@@ -1,4 +1,4 @@
-"""A sum-of-squares attempt for reach-type properties (reach, RWA, RAR) of a polynomial
+"""A sum-of-squares attempt for reach-type properties (reach, RWA, RSWA, RAR) of a polynomial
 ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where the decrease
 is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py), and for
 reach and RWA of a polynomial map (the decrease is V(f(x)) - V(x), still linear in V's
@@ -220,8 +220,7 @@ def _ball(states, radius: float) -> P.Polynomial:
     """r^2 - |x|^2 (>= 0 on the ball), with r^2 a short rational."""
     square = Fraction(radius ** 2).limit_denominator(10 ** 6)
     return P.add(P.constant(square, len(states)),
-                 *({tuple(2 * (k == i) for k in range(len(states))): Fraction(-1)}
-                   for i in range(len(states))))
+                 P.scale(P.polynomial(E.squared_norm(states), states), -1))
 
 
 def _distance_to_boundary(region, plan: Plan) -> float | None:
@@ -304,9 +303,9 @@ class _ReachProgram(Program):
             self.beta = self.scalar()
             self.at_most += [({self.beta: 1.0}, BOUND), ({self.beta: -1.0}, BOUND)]
             one = P.constant(1, n)
+            above = list(zip(self.coefficients, terms)) + [(self.beta, P.scale(one, -1))]
             for piece in stay.above:
-                self.require(list(zip(self.coefficients, terms)) + [(self.beta, P.scale(one, -1))],
-                             piece)
+                self.require(above, piece)
             self.require(negated + [(self.beta, one)], stay.inner)
 
     def levels(self, x) -> dict:
