@@ -204,3 +204,28 @@ def test_a_given_conserved_barrier_is_certified():
     result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=30)
     assert result.certified, result.summary()
     assert result.kernel.variant == "non-increasing B"
+
+
+def test_a_log_conserved_quantity_is_made_defined_where_the_domain_reaches_zero(tmp_path):
+    # probe52/m05: the SIR system conserves s + i - 0.5 log(s), and D holds s = 0, where
+    # log is undefined; s exp(-2 (s + i)) = exp(-2 H) is conserved and defined there
+    spec = fossil_dsl.loads((ROOT / "specs/probe52/m05_sir_peak_safety.fsl").read_text())
+    finding = first_integral.search(compile_spec(spec), float("inf"))
+    assert finding is not None and "log" not in E.to_text(finding.formula)
+    change = calculus.lie_derivative(finding.formula, ["s", "i"], spec.dynamics)
+    assert L.truth(folded(L.Compare(">", change, E.ZERO), ["s", "i"])) is False
+    assert L.truth(folded(L.Compare("<", change, E.ZERO), ["s", "i"])) is False
+    result = fossil_dsl.synthesise(spec, timeout=60)
+    assert result.certified, result.summary()
+    assert result.strategy.startswith("a conserved quantity"), result.strategy
+    result.save(tmp_path / "sir")
+    checks = recheck(tmp_path / "sir", timeout=30)
+    assert checks and all(c.reproved for c in checks), checks
+
+
+def test_no_power_makes_logs_of_opposite_signs_defined_at_zero():
+    assert first_integral._power_scale([Fraction(-1, 2)]) == -2
+    assert first_integral._power_scale([Fraction(2, 3), Fraction(1, 2)]) == 6
+    assert first_integral._power_scale([Fraction(1), Fraction(-1)]) is None
+    assert first_integral._power_scale([Fraction(5)]) == Fraction(1, 5)
+    assert first_integral._power_scale([Fraction(1), Fraction(7)]) is None  # x y^7

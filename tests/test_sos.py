@@ -7,7 +7,7 @@ import pytest
 import sympy
 
 import fossil_dsl
-from fossil_dsl.engine import sos, sos_barrier
+from fossil_dsl.engine import first_integral, sos, sos_barrier
 from fossil_dsl.plan.compile import compile_spec
 
 # Khalil's Example 4.? style: a polynomial system with a cubic coupling, 3 states
@@ -397,6 +397,10 @@ def test_a_barrier_no_quadratic_can_be_is_found_quartic_where_the_program_is_sma
     with monkeypatch.context() as patch:
         patch.setattr(sos_barrier, "DEGREES", (1,))
         assert sos_barrier.barrier(_plan(EPIDEMIC), time.monotonic() + 30) is None
+    found = sos_barrier.barrier(_plan(EPIDEMIC), time.monotonic() + 30)
+    assert found is not None and found.degree == 4
+    # (since session 53 a run takes s exp(-2 (s + i)), conserved, before the programs)
+    monkeypatch.setattr(first_integral, "applies", lambda plan: False)
     result = fossil_dsl.synthesise(fossil_dsl.loads(EPIDEMIC), timeout=60)
     assert result.certified, result.summary()
     assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 4")
@@ -436,3 +440,29 @@ def test_a_decrease_on_a_tight_sublevel_set_needs_multipliers_of_one_degree_more
     assert refutation_problem(found, decrease.query, plan.states) is None
     monkeypatch.setattr(sos_refutation, "RAISED_MAX_ENTRIES", 0)  # no raised programs
     assert sos_refutation.refute(decrease.query, plan.states, time.monotonic() + 60) is None
+
+
+def test_a_rational_field_gets_a_barrier_multiplied_through_its_denominator():
+    """probe53/n03, a chemostat with Monod uptake s/(0.5 + s): learning timed out
+    (120 s). Over the denominator 10 + 20 s (positive on D) the flow condition is
+    linear in B again; no B of degree 2 or 4 exists, one of degree 6 does."""
+    path = Path(__file__).resolve().parent.parent / "specs/probe53/n03_chemostat_washout_safety.fsl"
+    plan = compile_spec(fossil_dsl.load(path))
+    assert sos.applies(plan) and sos.field_of(plan) is None
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(sos_barrier, "DEGREES", (1, 2))
+        assert sos_barrier.barrier(plan, time.monotonic() + 30) is None
+    found = sos_barrier.barrier(plan, time.monotonic() + 30)
+    assert found is not None and found.degree == 6
+    result = fossil_dsl.synthesise(fossil_dsl.load(path), timeout=90)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 6")
+
+
+def test_a_rational_field_whose_denominator_changes_sign_on_d_gets_no_barrier():
+    text = (Path(__file__).resolve().parent.parent
+            / "specs/probe53/n03_chemostat_washout_safety.fsl").read_text()
+    text = text.replace("(0.5 + s)", "(s - 0.5)")
+    plan = compile_spec(fossil_dsl.loads(text))
+    assert sos.applies(plan)
+    assert sos_barrier.barrier(plan, time.monotonic() + 30) is None

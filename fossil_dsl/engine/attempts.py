@@ -5,13 +5,15 @@ then the learning loop with the time left. Whatever is tried, the kernel judges 
 formulas (and checks any refutation) alone."""
 from __future__ import annotations
 
+import functools
 import itertools
 import time
 
 import numpy as np
 from dataclasses import replace
 
-from fossil_dsl.engine import basin, first_integral, repelling, sos, sos_reach, torch_import
+from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos, sos_reach,
+                               torch_import)
 from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, only_function, prove_found,
                                        verify_given)
@@ -35,6 +37,7 @@ BASIN_QUERY_SECONDS = 30.0
 # a quadratic V's are found in well under a second)
 REACH_REFUTING_SECONDS = 5.0
 REPELLING_TRIES = 2  # barriers round a repelling equilibrium proved, at most
+QUADRATIC_TRIES = 2  # quadratic V of the linearisation proved, at most
 CONSERVED_REFINEMENTS = 3  # conserved-quantity barriers chosen again with counterexamples
 BASIN_TOTAL_SHARE = 0.5  # of the run's time, at most, for the whole attempt
 BASIN_REFINEMENTS = 3  # programs solved again with the solvers' counterexamples
@@ -51,6 +54,7 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
                              (first_integral.applies, _conserved),
                              (repelling.applies, _repelling),
                              (sos.applies, _sum_of_squares),
+                             (quadratic_roa.applies, _quadratic_region),
                              (sos_reach.applies, _reach_sum_of_squares)):
         if backend is not None and applies(plan):
             found, note = attempt(plan, backend, listener, deadline)
@@ -136,7 +140,18 @@ def _ball_left_out(plan: Plan, finding, radius) -> Plan:
     8 near 0 is beyond Z3, and a numerical procedure needs the ball excluded), so the
     ball is made small enough for the lemma's estimates where halving it helps (a
     quadratic part nearly flat in one direction needs a smaller ball)."""
-    claim = Claim(plan.spec, {plan.functions[0].name: finding.formula}, {}, {}, radius)
+    return _lemma_plan(plan, {plan.functions[0].name: finding.formula}, radius=radius)
+
+
+def _lemma_plan(plan: Plan, formulas: dict, controller=None, levels=None,
+                radius=None) -> Plan:
+    """The plan with the largest ball, of `radius` (default the plan's) halved up to
+    four times, whose neighbourhood of the origin the kernel's Taylor lemma covers for
+    the formulas (else the plan's own ball)."""
+    radius = radius or plan.origin_radius
+    if not radius:
+        return plan
+    claim = Claim(plan.spec, formulas, controller or {}, levels or {}, radius)
     return replace(plan, origin_radius=lemma_radius(claim) or radius)
 
 
@@ -149,6 +164,25 @@ def _repelling(plan: Plan, backend: Backend, listener, deadline: float):
                                   REACH_REFUTING_SECONDS)
         if found is not None:
             return found, ""
+    return None, note
+
+
+def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with V given, β fixed and the controller set, certified outcome) or None,
+    what happened)."""
+    listener.phase(0, "the linearisation's quadratic V")
+    budget = time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
+    note = "no quadratic V of the linearisation decreases where it holds I"
+    for finding in itertools.islice(quadratic_roa.candidates(plan, budget), QUADRATIC_TRIES):
+        # asymptotic stability where the Taylor lemma's ball can be proved round, else
+        # ε-stability with the plan's own ball (as for V shaped to the basin)
+        lemma = _lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
+        for attempt in (lemma,) if lemma.origin_radius == plan.origin_radius else (lemma, plan):
+            found, note = prove_found(attempt, backend, listener, deadline, finding,
+                                      REACH_REFUTING_SECONDS, formulas=finding.formulas,
+                                      prepare=functools.partial(_set_up, finding=finding))
+            if found is not None:
+                return found, ""
     return None, note
 
 

@@ -45,6 +45,7 @@ MAX_BASIS = 130  # candidates, at most (4 states, degree 4: 69 monomials)
 SAMPLES = 400  # of I and of U within D
 DECIMALS = 6  # kept of a and c
 MIN_MARGIN = 1e-6
+MAX_POWER = 4  # of a state, in a conserved function made defined at its 0 (see _defined_on_zero)
 
 
 @dataclass(frozen=True)
@@ -86,12 +87,15 @@ def search(plan: Plan, deadline: float, extra=None) -> ConservedFinding | None:
     field = [traversal.substitute(f, held) for f in spec.dynamics]
     box = spec.domain.bounding_box()
     positive = [s for s, low in zip(states, box[0]) if low > 0] if box else []
+    touching = [s for s, low in zip(states, box[0]) if low == 0] if box else []
     samples = None
-    for degree in DEGREES:
-        candidates = _candidates(field, states, degree, positive)
+    for degree, at_zero in _passes(touching):
+        candidates = _candidates(field, states, degree, positive + at_zero)
         if time.monotonic() > deadline or len(candidates) > MAX_BASIS:
             return None
-        basis = conserved(candidates, field, states, spec.time is TimeDomain.DISCRETE)
+        weights = _null_space(candidates, field, states, spec.time is TimeDomain.DISCRETE)
+        basis = [_defined_on_zero(w, candidates, at_zero) for w in weights]
+        basis = [h for h in basis if h is not None]
         if not basis:
             continue
         samples = samples or _samples(plan, extra)
@@ -115,9 +119,58 @@ def _candidates(field, states, degree: int, positive=()) -> list[E.Expr]:
         [E.apply("log", E.Var(s)) for s in positive]
 
 
+def _passes(touching: list[str]):
+    """(degree, states whose log is a candidate although D reaches their 0): those logs
+    only after every degree without them, so that a conserved polynomial is preferred."""
+    return [(d, []) for d in DEGREES] + ([(d, touching) for d in DEGREES] if touching else [])
+
+
+def _defined_on_zero(weights: list[Fraction], candidates, at_zero: list[str]):
+    """The combination of the candidates, or where it holds b log(x) of a state x that D
+    lets be 0: exp(l H) = x^(l b) exp(l (H - b log x)) with l b a positive integer for each
+    such log (the SIR system conserves s + i - 0.5 log(s), so s exp(-2 (s + i)): defined at
+    s = 0 and conserved as well). None where no small power l b does."""
+    logs = {c.arg.name: w for w, c in zip(weights, candidates) if w and _is_log(c)}
+    if not any(x in logs for x in at_zero):
+        return _combination(weights, candidates)
+    scale = _power_scale(list(logs.values()))
+    if scale is None:
+        return None
+    rest = _combination([0 if _is_log(c) else w * scale
+                         for w, c in zip(weights, candidates)], candidates)
+    powers = [E.power(E.Var(x), E.Num(b * scale)) for x, b in logs.items()]
+    return E.mul(*powers, E.apply("exp", rest))
+
+
+def _is_log(candidate: E.Expr) -> bool:
+    return isinstance(candidate, E.Apply) and candidate.func == "log"
+
+
+def _power_scale(coefficients: list[Fraction]) -> Fraction | None:
+    """l with l b a positive integer of at most MAX_POWER for each b, or None."""
+    if len({b > 0 for b in coefficients}) != 1:
+        return None
+    numerators = [abs(b.numerator) for b in coefficients]
+    denominators = [b.denominator for b in coefficients]
+    common = Fraction(int(np.gcd.reduce(numerators)), int(np.lcm.reduce(denominators)))
+    scale = (1 if coefficients[0] > 0 else -1) / common
+    return scale if all(b * scale <= MAX_POWER for b in coefficients) else None
+
+
+def _combination(weights: list[Fraction], candidates) -> E.Expr:
+    return E.add(*(E.mul(E.Num(w), c) for w, c in zip(weights, candidates) if w))
+
+
 def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:
     """A basis (exact, each scaled to largest weight 1) of the combinations of the
     candidates whose change along the system is identically 0 over the atoms."""
+    return [_combination(w, candidates)
+            for w in _null_space(candidates, field, states, discrete)]
+
+
+def _null_space(candidates, field, states, discrete: bool) -> list[list[Fraction]]:
+    """The weights of conserved combinations of the candidates (a basis, each scaled to
+    largest weight 1)."""
     import flint
     changes = [calculus.change(c, states, field, discrete) for c in candidates]
     try:
@@ -126,15 +179,15 @@ def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:
         return []
     rows = sorted({m for p in polynomials for m in p})
     if not rows:  # every candidate is conserved (f = 0, or the identity map)
-        return list(candidates)
+        return [[Fraction(int(j == k)) for j in range(len(candidates))]
+                for k in range(len(candidates))]
     table = [_integer_row([p.get(m, Fraction(0)) for p in polynomials]) for m in rows]
     space, count = flint.fmpz_mat(len(rows), len(candidates), sum(table, [])).nullspace()
     found = []
     for k in range(count):
         weights = [Fraction(int(space[j, k])) for j in range(len(candidates))]
         top = max(abs(w) for w in weights)
-        found.append(E.add(*(E.mul(E.Num(w / top), c)
-                             for w, c in zip(weights, candidates) if w)))
+        found.append([w / top for w in weights])
     return found
 
 

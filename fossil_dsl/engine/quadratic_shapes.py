@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import itertools
 import math
+from fractions import Fraction
 
 import numpy as np
 
 from fossil_dsl.engine.linear import (MAX_CONDITION, as_array, closed_loop, lyapunov_matrix,
                                       separation)
+from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials
 from fossil_dsl.ir import sets as S
 from fossil_dsl.solvers.sdp import Program
@@ -36,6 +38,31 @@ def lqr_gains(spec, controlled: bool, operating, rng, state=None):
         found = closed_loop(spec, controlled, operating, *weights, state=state)
         if found is not None:
             yield found
+
+
+def lqr_controllers(plan, operating: np.ndarray, rng):
+    """(input -> exact formula, -K) for each LQR gain (rounded to the digits the
+    verifier sees), or one ({}, None) without inputs."""
+    spec = plan.spec
+    if not spec.inputs:
+        yield {}, None
+        return
+    for _, K in lqr_gains(spec, True, operating, rng):
+        yield exact_controller(spec, -K, operating, plan.options.digits)
+
+
+def exact_controller(spec, gain: np.ndarray, operating: np.ndarray, digits: int):
+    """(input -> exact formula of u = gain x + operating, the gain rounded to `digits`
+    decimals as the controller network holds it)."""
+    gain = np.round(gain, digits)
+    bias = np.round(operating, digits)
+    return {u: E.add(*(E.mul(E.Num(_exact(w)), E.Var(s)) for w, s in zip(row, spec.states)),
+                     E.Num(_exact(b)))
+            for u, row, b in zip(spec.inputs, gain, bias)}, gain
+
+
+def _exact(value: float) -> Fraction:
+    return Fraction(str(float(value)))
 
 
 def initial_middle(spec, inside) -> np.ndarray | None:

@@ -31,6 +31,7 @@ from fractions import Fraction
 import numpy as np
 
 from fossil_dsl.engine.linear import operating_point
+from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.engine.sos import Inexact, interval_products, set_constraints
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
@@ -101,7 +102,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     rng = np.random.default_rng(plan.options.seed)
     box = spec.domain.bounding_box()
     discrete = spec.time is TimeDomain.DISCRETE
-    for controller, gain in _controllers(plan, operating, rng):
+    for controller, gain in lqr_controllers(plan, operating, rng):
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
         field = _polynomial(closed, states)
         denominator = P.constant(1, len(states))
@@ -120,27 +121,6 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
                                 controller, gain, operating, degree, margin,
                                 time.monotonic() - started, levels)
     return None
-
-
-def _controllers(plan: Plan, operating: np.ndarray, rng):
-    """(input -> exact formula, -K) for each LQR gain (rounded to the digits the
-    verifier sees), or one ({}, None) without inputs."""
-    from fossil_dsl.engine.quadratic_shapes import lqr_gains
-    spec = plan.spec
-    if not spec.inputs:
-        yield {}, None
-        return
-    digits = plan.options.digits
-    for _, K in lqr_gains(spec, True, operating, rng):
-        gain = np.round(-K, digits)
-        bias = np.round(operating, digits)
-        yield {u: E.add(*(E.mul(E.Num(_exact(w)), E.Var(s)) for w, s in zip(row, spec.states)),
-                        E.Num(_exact(b)))
-               for u, row, b in zip(spec.inputs, gain, bias)}, gain
-
-
-def _exact(value: float) -> Fraction:
-    return Fraction(str(float(value)))
 
 
 def same_polynomial(first: E.Expr, second: E.Expr, states) -> bool:

@@ -1,0 +1,203 @@
+"""A region of attraction from the linearisation, the textbook way: V = x^T P x with P
+from the Lyapunov equation of the linearised (with inputs, LQR-closed) system, and β
+just over V's largest value on I, the smallest sublevel set that holds I: the smaller
+Ω, the fewer states where dV/dt < 0 must hold. A (P, β) is a candidate where Ω lies in
+D (worked out for a box or ball) and V decreases at thousands of samples of Ω and of
+its shell {V = β}; the decrease asked of P is Q = I, then random diagonal weights.
+
+The attempt is for `from I: stable` (no `region: largest`, which shapes V to the
+simulated basin) and `from I: stable and always not U`, with B = V - β where Ω misses U
+(Ω cannot be left, so {B <= 0} cannot either). A learner whose level is halfway between I and ∂D, or whose margin
+is large against a small V, misses such a pair (probe53/n01, an excitable neuron: the
+Lyapunov equation's V holds at β = 1.05 times its largest value on I and fails at the
+halfway level). Nothing here is trusted: V and β are proved like any candidate.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from fossil_dsl.engine.evaluate import holds, state_env
+from fossil_dsl.engine.sampling import sample
+from fossil_dsl.engine.trajectories import numeric_field
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
+from fossil_dsl.ir.sets import Intersection
+from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.plan.compile import Plan, default_synthesis
+
+WEIGHTINGS = 6  # decreases Q asked of P for each gain: I, then random diagonal ones
+WEIGHT_SPREAD = 1.0  # their entries 10^u, u uniform in [-spread, spread]
+INSIDE, SHELL = 4000, 2000  # samples of Ω and of its boundary {V = β}
+LEVEL_CUSHION = 1.01  # β over the largest V on I (an upper bound worked out for I's shape)
+SIGNIFICANT = 6  # digits kept of P's entries
+UNSAFE_SAMPLES = 2000  # of U within D (stable while avoid): V > β there
+# stable while avoid takes B = V - β: Ω cannot be left, so it is a barrier where it misses U
+FORMS = ("region of attraction", "stable while avoid")
+
+
+@dataclass(frozen=True)
+class QuadraticFinding:
+    formulas: dict  # "V" -> x^T P x, exact
+    controller: dict  # input -> exact formula (empty without inputs)
+    gain: np.ndarray | None
+    operating: np.ndarray
+    levels: dict  # "beta" -> Fraction
+    seconds: float
+
+    def describe(self) -> str:
+        control = " and a linear controller" if self.controller else ""
+        return (f"the linearisation's quadratic V{control} on its smallest sublevel set "
+                f"holding I, {self.seconds:.2f} s")
+
+
+def applies(plan: Plan) -> bool:
+    spec = plan.spec
+    return (plan.certificate.form in FORMS and default_synthesis(plan)
+            and not plan.options.largest_region and spec.domain.bounding_box() is not None)
+
+
+def candidates(plan: Plan, deadline: float):
+    """QuadraticFindings that pass the sampled checks, in the order found."""
+    from fossil_dsl.engine.linear import jacobians, operating_point  # imports torch
+    started = time.monotonic()
+    spec = plan.spec
+    operating = operating_point(spec) if spec.inputs else np.zeros(0)
+    found = None if operating is None else jacobians(spec, operating)
+    if found is None:
+        return
+    rng = np.random.default_rng(plan.options.seed)
+    discrete = spec.time is TimeDomain.DISCRETE
+    for controller, gain, P in _shapes(plan, *found, operating, rng):
+        if time.monotonic() > deadline:
+            return
+        field = numeric_field([traversal.substitute(f, controller) for f in spec.dynamics],
+                              plan.states)
+        shape = None if P is None else _exact_shape(P)
+        level = None if shape is None else _level(plan, shape)
+        if level is not None and _decreases(plan, field, shape, level, discrete, rng) \
+                and _misses_unsafe(plan, shape, level, rng):
+            V = _quadratic(shape, plan.states)
+            formulas = {"V": V} if plan.certificate.form == FORMS[0] else \
+                {"V": V, "B": E.add(V, E.Num(-level))}
+            yield QuadraticFinding(formulas, controller, gain, operating, {"beta": level},
+                                   time.monotonic() - started)
+
+
+def _shapes(plan: Plan, A: np.ndarray, B: np.ndarray, operating: np.ndarray, rng):
+    """(controller, its gain, P) in turn: the Lyapunov matrices of the first LQR gain's
+    closed loop (identity weights), the ellipsoid between I and D that the linearisation
+    keeps (ellipsoid_seed.py; where the LQR ellipsoids are flat, every sublevel set that
+    holds I leaves D), then the other LQR gains' Lyapunov matrices."""
+    from fossil_dsl.engine.ellipsoid_seed import ellipsoid
+    from fossil_dsl.engine.linear import lyapunov_matrix
+    from fossil_dsl.engine.quadratic_shapes import exact_controller, lqr_controllers
+    spec = plan.spec
+    discrete = spec.time is TimeDomain.DISCRETE
+    controllers = lqr_controllers(plan, operating, rng)
+    for index, (controller, gain) in enumerate(controllers):
+        closed = A if gain is None else A + B @ gain
+        if _stable(closed, discrete):  # (else no P: scipy warns of a centre's eigenvalues)
+            for Q in _weightings(len(A), rng):
+                yield controller, gain, lyapunov_matrix(closed, discrete, Q)
+        if index == 0:
+            found = ellipsoid(A, B if spec.inputs else np.zeros((len(A), 0)), spec, discrete)
+            if found is not None:
+                P, K = found
+                controller, gain = exact_controller(spec, K, operating, plan.options.digits) \
+                    if spec.inputs else ({}, None)
+                yield controller, gain, P
+
+
+def _stable(A: np.ndarray, discrete: bool) -> bool:
+    eigenvalues = np.linalg.eigvals(A)
+    return bool(np.all(np.abs(eigenvalues) < 1) if discrete else np.all(eigenvalues.real < 0))
+
+
+def _quadratic(shape, states) -> E.Expr:
+    """x^T P x, each product once."""
+    return E.add(*(E.mul(E.Num(shape[i][j] * (1 if i == j else 2)),
+                         E.power(E.Var(a), E.Num(2)) if i == j else E.mul(E.Var(a), E.Var(b)))
+                   for i, a in enumerate(states) for j, b in enumerate(states)
+                   if j >= i and shape[i][j]))
+
+
+def _weightings(n: int, rng):
+    yield np.eye(n)
+    for _ in range(WEIGHTINGS - 1):
+        yield np.diag(10 ** rng.uniform(-WEIGHT_SPREAD, WEIGHT_SPREAD, n))
+
+
+def _exact_shape(P: np.ndarray) -> list[list[Fraction]] | None:
+    """P's entries rounded to SIGNIFICANT digits, symmetric; None where the rounded
+    matrix is not positive definite."""
+    shape = [[Fraction(f"{P[min(i, j), max(i, j)]:.{SIGNIFICANT}g}") for j in range(len(P))]
+             for i in range(len(P))]
+    return shape if np.linalg.eigvalsh(_floats(shape))[0] > 0 else None
+
+
+def _floats(shape) -> np.ndarray:
+    return np.array([[float(v) for v in row] for row in shape])
+
+
+def _level(plan: Plan, shape) -> Fraction | None:
+    """β just over an upper bound of V on I, where Ω = {V <= β} lies inside D by the
+    shapes' bounds (else None)."""
+    from fossil_dsl.engine.quadratic_shapes import boundary_floor, set_ceiling
+    P, centre = _floats(shape), np.zeros(len(shape))
+    ceiling = set_ceiling(P, plan.spec.property.role("initial"), centre)
+    floor = boundary_floor(P, plan.spec.domain, centre)
+    if ceiling is None or floor is None or not 0 < ceiling * LEVEL_CUSHION < floor:
+        return None
+    return Fraction(f"{ceiling * LEVEL_CUSHION:.3g}")
+
+
+def _misses_unsafe(plan: Plan, shape, level: Fraction, rng) -> bool:
+    """V > β at samples of U within D (and above the bound worked out for U's shape,
+    where there is one), or there is no U."""
+    from fossil_dsl.engine.quadratic_shapes import set_floor
+    unsafe = plan.spec.property.role("unsafe")
+    if unsafe is None:
+        return True
+    P = _floats(shape)
+    floor = set_floor(P, unsafe, np.zeros(len(P)))
+    if floor is not None and floor <= level:
+        return False
+    points = np.asarray(sample(Intersection(unsafe, plan.spec.domain), plan.states,
+                               UNSAFE_SAMPLES, rng, plan.spec.domain.bounding_box()), float)
+    points = points.reshape(-1, len(P))
+    return bool(np.all(np.einsum("bi,ij,bj->b", points, P, points) > float(level)))
+
+
+def _decreases(plan: Plan, field, shape, level: Fraction, discrete: bool, rng) -> bool:
+    """V decreases (and, for a map, f(x) stays in D) at samples of Ω and of its shell."""
+    P = _floats(shape)
+    points = _ellipsoid_points(P, float(level), rng)
+    with np.errstate(all="ignore"):
+        image = field(points)
+        values = np.einsum("bi,ij,bj->b", points, P, points)
+        if discrete:
+            change = np.einsum("bi,ij,bj->b", image, P, image) - values
+            in_domain = holds(plan.spec.domain.contains_formula(plan.states),
+                              state_env(plan.states, np.nan_to_num(image, nan=1e9)),
+                              len(points))
+            if not np.all(np.asarray(in_domain, bool)):
+                return False
+        else:
+            change = 2 * np.einsum("bi,ij,bj->b", points, P, image)
+    return bool(np.all(change < 0))
+
+
+def _ellipsoid_points(P: np.ndarray, level: float, rng) -> np.ndarray:
+    """Uniform samples of {x^T P x <= level} and of its boundary (none at the origin)."""
+    n = len(P)
+    directions = rng.normal(size=(INSIDE + SHELL, n))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    radii = np.concatenate([rng.uniform(1e-6, 1, INSIDE) ** (1 / n), np.ones(SHELL)])
+    # x = sqrt(level) L^-T u for P = L L^T maps the unit ball onto the ellipsoid
+    L = np.linalg.cholesky(P)
+    return math.sqrt(level) * np.linalg.solve(L.T, (radii[:, None] * directions).T).T
