@@ -66,6 +66,17 @@ def test_reach_avoid_remain_with_a_controller_is_certified_by_the_program():
     assert k.total_degree() == 1 and all(c < 0 for c in k.coeffs()[:2])
 
 
+def test_reach_avoid_remain_past_a_hardening_spring_gets_a_quartic_barrier():
+    """probe54/o07: x^3 outgrows the decay of every quadratic B on D (the program with
+    degree 2 is infeasible), so B of degree 4; fails where only quadratic B are tried."""
+    spec = fossil_dsl.load(ROOT / "specs/probe54/o07_duffing_rar.fsl")
+    result = fossil_dsl.synthesise(spec, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert "B of degree 4" in result.strategy, result.strategy
+    B = result.sympy["B"]
+    assert sympy.Poly(B, *sorted(B.free_symbols, key=str)).total_degree() == 4
+
+
 def test_the_program_finds_nothing_for_a_false_reach_property():
     plan = compile_spec(fossil_dsl.loads(STRAIGHT_THROUGH))
     assert sos_reach.applies(plan)

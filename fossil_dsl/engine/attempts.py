@@ -123,8 +123,7 @@ def _shaped_proof(plan: Plan, finding, backend: Backend, listener, deadline: flo
     than nothing; the counterexamples are then the latter's."""
     radius = plan.origin_radius or origin_radius(plan.spec)
     lemma = _ball_left_out(plan, finding, radius)
-    for attempt in (lemma,) if lemma.origin_radius == radius else \
-            (lemma, replace(plan, origin_radius=radius)):
+    for attempt in _lemma_then_own(lemma, replace(plan, origin_radius=radius)):
         given, outcome = verify_given(attempt, backend, listener, deadline,
                                       only_function(attempt, finding.formula),
                                       BASIN_QUERY_SECONDS,
@@ -132,6 +131,12 @@ def _shaped_proof(plan: Plan, finding, backend: Backend, listener, deadline: flo
         if outcome.certified or time.monotonic() > deadline:
             break
     return given, outcome
+
+
+def _lemma_then_own(lemma: Plan, own: Plan) -> tuple:
+    """The plans to prove with in turn: the Taylor lemma's ball (asymptotic stability),
+    then, where that is another ball, the plan's own (ε-stability rather than nothing)."""
+    return (lemma,) if lemma.origin_radius == own.origin_radius else (lemma, own)
 
 
 def _ball_left_out(plan: Plan, finding, radius) -> Plan:
@@ -174,10 +179,8 @@ def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
     budget = time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
     note = "no quadratic V of the linearisation decreases where it holds I"
     for finding in itertools.islice(quadratic_roa.candidates(plan, budget), QUADRATIC_TRIES):
-        # asymptotic stability where the Taylor lemma's ball can be proved round, else
-        # ε-stability with the plan's own ball (as for V shaped to the basin)
         lemma = _lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
-        for attempt in (lemma,) if lemma.origin_radius == plan.origin_radius else (lemma, plan):
+        for attempt in _lemma_then_own(lemma, plan):
             found, note = prove_found(attempt, backend, listener, deadline, finding,
                                       REACH_REFUTING_SECONDS, formulas=finding.formulas,
                                       prepare=functools.partial(_set_up, finding=finding))

@@ -72,11 +72,13 @@ def candidates(plan: Plan, deadline: float):
         return
     rng = np.random.default_rng(plan.options.seed)
     discrete = spec.time is TimeDomain.DISCRETE
+    closed_loop, field = None, None
     for controller, gain, P in _shapes(plan, *found, operating, rng):
         if time.monotonic() > deadline:
             return
-        field = numeric_field([traversal.substitute(f, controller) for f in spec.dynamics],
-                              plan.states)
+        if controller is not closed_loop:  # (the weightings of one gain share it)
+            closed_loop, field = controller, numeric_field(
+                [traversal.substitute(f, controller) for f in spec.dynamics], plan.states)
         shape = None if P is None else _exact_shape(P)
         level = None if shape is None else _level(plan, shape)
         if level is not None and _decreases(plan, field, shape, level, discrete, rng) \

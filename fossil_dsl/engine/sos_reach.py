@@ -17,13 +17,14 @@ set's constraints; "outside a set's interior" is one piece per constraint g >= 0
 set, where g <= 0). The last asks dV/dt <= -γ even where V > 0, which is stronger than the
 condition but keeps the program linear in V; V's sublevel set {V <= 0} may lie anywhere,
 so it need not be centred at the origin (an I on one side of G, an unsafe set on the
-other: no ellipsoid round the origin fits between them). For RAR, B comes from the barrier
+other: no ellipsoid round the origin fits between them). For RAR, B (degree 2, then 4) comes from the barrier
 program (sos_barrier.py) with G for I and the part of D outside F for U.
 
 Nothing here is trusted: the functions are rounded and proved like any candidate.
 """
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import dataclass
 from fractions import Fraction
@@ -69,12 +70,14 @@ class ReachFinding:
     margin: float
     seconds: float
     levels: dict  # name -> Fraction (RSWA's β), fixed for the proof
+    barrier_degree: int = 0  # RAR's B (0: none)
 
     def describe(self) -> str:
         control = " for an LQR gain of the linearisation" if self.controller else ""
+        barrier = "" if not self.barrier_degree else " and a quadratic B" \
+            if self.barrier_degree == 2 else f" and B of degree {self.barrier_degree}"
         return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}"
-                f"{' and a quadratic B' if 'B' in self.formulas else ''}{control}, "
-                f"margin {self.margin:.3g}, {self.seconds:.2f} s")
+                f"{barrier}{control}, margin {self.margin:.3g}, {self.seconds:.2f} s")
 
 
 def applies(plan: Plan) -> bool:
@@ -119,7 +122,8 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
             formulas, levels, degree, margin = found
             return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
                                 controller, gain, operating, degree, margin,
-                                time.monotonic() - started, levels)
+                                time.monotonic() - started, levels,
+                                P.degree(formulas["B"]) if "B" in formulas else 0)
     return None
 
 
@@ -245,12 +249,13 @@ def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
 
 
 def _barrier(n: int, field, pieces: _Pieces, deadline: float):
-    """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B on D; or None."""
-    for mu in DECAY_RATES:
+    """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B on D, of degree 2, then 4 (a
+    hardening spring's x^3 outgrows every quadratic's decay on D: probe54/o07); or None."""
+    for half, mu in itertools.product(HALF_DEGREES, DECAY_RATES):
         if time.monotonic() > deadline:
             return None
         program = BarrierProgram(n, field, pieces.goal, pieces.outside_final, pieces.domain,
-                                 1, mu)
+                                 half, mu)
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
             return program.exact_b(x)
