@@ -2,6 +2,7 @@
 wrong certificates rejected, honest UNKNOWN, and obligations re-checked by another solver."""
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -357,6 +358,9 @@ def test_restart_draws_new_weights_and_keeps_the_samples():
     learner.restart()
     assert all(not torch.equal(a, b) for a, b in zip(before, learner.parameters))
     assert all(torch.equal(samples[k], learner.samples[k]) for k in samples)
+    # a fresh optimiser (no moments of the old weights), made on the next step
+    assert learner.optimiser is None and learner.trainable
+    learner.train(1, time.monotonic() + 60)
     assert learner.optimiser.param_groups[0]["params"] == learner.parameters
 
 

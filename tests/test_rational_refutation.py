@@ -146,3 +146,56 @@ def test_a_rational_condition_proved_by_a_solver_is_rechecked_by_a_refutation():
     # and it never re-proves the expanding map
     check = _decide("condition-decrease", _decrease_query(F(2)), STATES, "cvc5", 10, None)
     assert check.status != "unsat", check
+
+
+@pytest.mark.parametrize("divisor", [
+    E.add(E.Num(1), E.power(E.add(E.Num(1), Z), E.Num(2))),  # 1 + (1 + z)^2: y^2 + 2 y + 2
+    E.add(E.power(E.add(X, E.neg(Y)), E.Num(2)), E.Num(F(1, 2))),
+    E.mul(E.add(E.Num(2), E.power(E.add(X, Z), E.Num(4))), E.add(E.Num(1), E.power(Y, E.Num(2)))),
+    E.power(E.add(E.Num(1), E.power(E.add(E.Num(1), Z), E.Num(2))), E.Num(3)),
+])
+def test_a_divisor_positive_by_its_form_gives_a_polynomial_form(divisor):
+    """The repressilator's 2 / (1 + (1 + y)^2) (probe55/p01): expanded, the divisor has an
+    odd monomial, but its form (a positive number plus an even power) shows it positive."""
+    expression = E.div(Y, divisor)
+    top, bottom = P.over_positive(expression, STATES)
+    for point in [(F(1), F(-2), F(-1)), (F(-3, 2), F(1, 3), F(5, 7)), (F(0), F(0), F(-1))]:
+        assert _at(bottom, point) > 0
+        folded = traversal.substitute(expression, dict(zip(STATES, map(E.Num, point))))
+        assert folded.value == _at(top, point) / _at(bottom, point)
+
+
+@st.composite
+def forms(draw, depth: int = 3):
+    """Expressions of numbers of either sign, states, sums, products, quotients,
+    negations and integer powers (negative too)."""
+    if depth == 0 or draw(st.booleans()):
+        return draw(st.sampled_from([X, Y, Z, E.Num(F(draw(st.integers(-3, 3)), 2))]))
+    kind = draw(st.sampled_from(["add", "mul", "div", "neg", "pow"]))
+    first, second = draw(forms(depth - 1)), draw(forms(depth - 1))
+    exponent = E.Num(draw(st.integers(-3, 4)))
+    build = {"add": lambda: E.add(first, second), "mul": lambda: E.mul(first, second),
+             "div": lambda: E.div(first, second), "neg": lambda: E.neg(first),
+             "pow": lambda: E.power(first, exponent)}[kind]
+    try:
+        return build()
+    except (E.ExprError, ZeroDivisionError):  # folded to a division by zero
+        return first
+
+
+@settings(max_examples=300, deadline=None)
+@given(forms(), rationals, rationals, rationals)
+def test_what_the_form_shows_of_the_sign_holds_at_every_point(expression, x, y, z):
+    """Soundness of `sign_by_form`: POSITIVE means > 0 wherever the expression is
+    defined, NONNEGATIVE >= 0."""
+    sign = P.sign_by_form(expression)
+    try:
+        folded = traversal.substitute(expression, {"x": E.Num(x), "y": E.Num(y), "z": E.Num(z)})
+    except (E.ExprError, ZeroDivisionError):
+        return  # undefined at the point
+    if not isinstance(folded, E.Num):
+        return
+    if sign == P.POSITIVE:
+        assert folded.value > 0, (expression, folded)
+    if sign == P.NONNEGATIVE:
+        assert folded.value >= 0, (expression, folded)

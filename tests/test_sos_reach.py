@@ -272,3 +272,32 @@ def test_the_program_finds_nothing_for_a_false_reach_and_stay_property(name):
     if sos_reach.applies(plan):
         assert sos_reach.search(plan, time.monotonic() + 30) is None
     assert not fossil_dsl.synthesise(spec, seed=0, timeout=20, max_iters=3).certified
+
+
+def test_a_field_with_exp_is_solved_for_a_polynomial_stand_in():
+    """probe55/p07, a damped Morse oscillator (RSWA): exp(-x) keeps the field from the
+    program, and learning's quadratic V failed for 19 iterations (its sublevel set holds
+    I's mirror image, which meets U). The program, solved for a degree-7 least-squares
+    stand-in for the field, gives a quartic V that the kernel proves for the true field."""
+    spec = fossil_dsl.load(ROOT / "specs/probe55/p07_morse_oscillator_rswa.fsl")
+    assert sos_reach.applies(compile_spec(spec))
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert "polynomial stand-in of degree" in result.strategy, result.strategy
+    assert "exp" in str(compile_spec(spec).spec.dynamics)  # proved for the true field
+
+
+def test_a_stand_in_keeps_polynomial_components_and_fits_the_others():
+    from fossil_dsl.engine.surrogate import TOLERANCE, polynomial_field
+    x, y = E.Var("x0"), E.Var("x1")
+    states = ["x0", "x1"]
+    domain = compile_spec(fossil_dsl.loads(STRAIGHT_THROUGH)).spec.domain  # [-2, 2]^2
+    field = [y, E.neg(E.apply("sin", x))]
+    fitted = polynomial_field(field, states, domain)
+    assert fitted[0] == {(0, 1): 1}  # exactly y
+    grid = np.linspace(-2, 2, 41)
+    error = max(abs(sum(float(c) * v ** m[0] * w ** m[1] for m, c in fitted[1].items())
+                    + math.sin(v)) for v in grid for w in grid)
+    assert error <= 2 * TOLERANCE and all(m[1] == 0 for m in fitted[1])
+    # exp(4 x) on [-2, 2] (up to e^8): no fit of degree 7 is within the tolerance
+    assert polynomial_field([y, E.apply("exp", E.mul(E.Num(4), x))], states, domain) is None

@@ -73,7 +73,9 @@ class Learner(ViolationSearch):
             or self.seed_from(reach_seed.candidates(plan, self.networks, self.controller,
                                                     self.samples))
         self.parameters = [p for m in self.modules() for p in m.parameters()]
-        self.optimiser = self.new_optimiser() if self.parameters else None
+        # made on the first step: creating one imports torch._dynamo (1.8 s), which a
+        # found candidate proved with a controller never needs (probe48/c03)
+        self.optimiser = None
 
     def seed_from(self, candidates, least_loss: bool = True) -> bool:
         """Of (preferred, set_seed) pairs, best first: the first preferred seed that meets
@@ -101,7 +103,7 @@ class Learner(ViolationSearch):
         every counterexample so far) are kept."""
         for module in self.modules():
             module.reset()
-        self.optimiser = self.new_optimiser()
+        self.optimiser = None
         self.digits = self.plan.options.digits
 
     def new_optimiser(self) -> torch.optim.Adam:
@@ -113,7 +115,7 @@ class Learner(ViolationSearch):
 
     @property
     def trainable(self) -> bool:
-        return self.optimiser is not None
+        return bool(self.parameters)
 
     # ---- values ----
     def field(self, points: torch.Tensor, open_loop: bool = False) -> list[torch.Tensor]:
@@ -277,6 +279,8 @@ class Learner(ViolationSearch):
                     break
                 searches += 1
                 continue
+            if self.optimiser is None:
+                self.optimiser = self.new_optimiser()
             self.optimiser.zero_grad()
             loss.backward()
             _clip_gradients(self.parameters, 10.0)

@@ -1,6 +1,7 @@
-"""A sum-of-squares attempt for reach-type properties (reach, RWA, RSWA, RAR) of a polynomial
-ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where the decrease
-is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py), and for
+"""A sum-of-squares attempt for reach-type properties (reach, RWA, RSWA, RAR) of a
+polynomial ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where
+the decrease is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py;
+of any other ODE through a polynomial stand-in for its field: surrogate.py), and for
 reach and RWA of a polynomial map (the decrease is V(f(x)) - V(x), still linear in V's
 coefficients; the kernel's further condition that a step from S outside G with V <= 0
 lands in S is left to the proof); where the system has inputs, with a linear controller
@@ -17,8 +18,9 @@ set's constraints; "outside a set's interior" is one piece per constraint g >= 0
 set, where g <= 0). The last asks dV/dt <= -γ even where V > 0, which is stronger than the
 condition but keeps the program linear in V; V's sublevel set {V <= 0} may lie anywhere,
 so it need not be centred at the origin (an I on one side of G, an unsafe set on the
-other: no ellipsoid round the origin fits between them). For RAR, B (degree 2, then 4) comes from the barrier
-program (sos_barrier.py) with G for I and the part of D outside F for U.
+other: no ellipsoid round the origin fits between them). For RAR, B (degree 2, then 4)
+comes from the barrier program (sos_barrier.py) with G for I and the part of D outside F
+for U.
 
 Nothing here is trusted: the functions are rounded and proved like any candidate.
 """
@@ -36,6 +38,7 @@ from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.engine.sos import Inexact, interval_products, set_constraints
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
+from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
@@ -71,24 +74,32 @@ class ReachFinding:
     seconds: float
     levels: dict  # name -> Fraction (RSWA's β), fixed for the proof
     barrier_degree: int = 0  # RAR's B (0: none)
+    stand_in: int = 0  # the degree of the field's polynomial stand-in (0: none)
 
     def describe(self) -> str:
         control = " for an LQR gain of the linearisation" if self.controller else ""
-        barrier = "" if not self.barrier_degree else " and a quadratic B" \
-            if self.barrier_degree == 2 else f" and B of degree {self.barrier_degree}"
+        if not self.barrier_degree:
+            barrier = ""
+        elif self.barrier_degree == 2:
+            barrier = " and a quadratic B"
+        else:
+            barrier = f" and B of degree {self.barrier_degree}"
+        stand_in = (f" (solved for a polynomial stand-in of degree {self.stand_in} for "
+                    "the field)") if self.stand_in else ""
         return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}"
-                f"{barrier}{control}, margin {self.margin:.3g}, {self.seconds:.2f} s")
+                f"{barrier}{control}{stand_in}, margin {self.margin:.3g}, "
+                f"{self.seconds:.2f} s")
 
 
 def applies(plan: Plan) -> bool:
-    """A polynomial or rational ODE, or a polynomial map for reach and RWA (RAR's
-    barrier program is for ODEs), a reach-type property, the default templates, and at
-    most a linear controller (the default one)."""
+    """An ODE (polynomial, rational, or with a polynomial stand-in: surrogate.py), or a
+    polynomial map for reach and RWA (RAR's barrier program is for ODEs), a reach-type
+    property, the default templates, and at most a linear controller (the default one)."""
     spec = plan.spec
     discrete = spec.time is TimeDomain.DISCRETE
     return (plan.certificate.form in (DISCRETE_FORMS if discrete else FORMS)
             and default_synthesis(plan)
-            and all(traversal.is_arithmetic(f) for f in spec.dynamics))
+            and (not discrete or all(traversal.is_arithmetic(f) for f in spec.dynamics)))
 
 
 def search(plan: Plan, deadline: float) -> ReachFinding | None:
@@ -108,13 +119,12 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     for controller, gain in lqr_controllers(plan, operating, rng):
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
         field = _polynomial(closed, states)
-        denominator = P.constant(1, len(states))
-        if field is None:  # a rational field: the programs are multiplied through by Q
-            found = None if discrete else over_one_denominator(closed, states, box,
-                                                               plan.options.seed)
-            if found is None or pieces.outside_final is not None:
-                continue  # (RAR's barrier program is for polynomial fields)
-            field, denominator = found
+        denominator, stand_in = P.constant(1, len(states)), 0
+        if field is None:
+            found = None if discrete else _over_denominator(closed, plan, pieces)
+            if found is None:
+                continue
+            field, denominator, stand_in = found
         if time.monotonic() > deadline:
             continue
         found = _functions(len(states), field, denominator, pieces, deadline, discrete)
@@ -123,8 +133,24 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
             return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
                                 controller, gain, operating, degree, margin,
                                 time.monotonic() - started, levels,
-                                P.degree(formulas["B"]) if "B" in formulas else 0)
+                                P.degree(formulas["B"]) if "B" in formulas else 0, stand_in)
     return None
+
+
+def _over_denominator(closed, plan: Plan, pieces: _Pieces):
+    """(N, Q, the stand-in's degree) for an ODE that is not polynomial: a rational field
+    over one denominator Q > 0 (the programs are multiplied through by Q; RAR's barrier
+    program is for polynomial fields), else a polynomial stand-in over Q = 1; or None."""
+    states = plan.states
+    if all(traversal.is_arithmetic(f) for f in closed):
+        found = over_one_denominator(closed, states, plan.spec.domain.bounding_box(),
+                                     plan.options.seed)
+        if found is not None:
+            return None if pieces.outside_final is not None else (*found, 0)
+    field = polynomial_field(closed, states, plan.spec.domain, plan.options.seed)
+    if field is None:
+        return None
+    return field, P.constant(1, len(states)), max(P.degree(p) for p in field)
 
 
 def same_polynomial(first: E.Expr, second: E.Expr, states) -> bool:

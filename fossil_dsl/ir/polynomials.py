@@ -79,25 +79,52 @@ def over_positive(expr: E.Expr, states: Sequence[str]) -> tuple[Polynomial, Poly
         return scale(top, -1), bottom
     if isinstance(expr, E.Div):
         top, bottom = over_positive(expr.numerator, states)
-        return _divided((top, bottom), over_positive(expr.denominator, states))
+        return _divided((top, bottom), over_positive(expr.denominator, states),
+                        sign_by_form(expr.denominator) == POSITIVE)
     if isinstance(expr, E.Pow) and isinstance(expr.exponent, E.Num) \
             and expr.exponent.value.denominator == 1:
         k = int(expr.exponent.value)
         top, bottom = over_positive(expr.base, states)
         if k < 0:
-            top, bottom = _divided((constant(1, n), constant(1, n)), (top, bottom))
+            top, bottom = _divided((constant(1, n), constant(1, n)), (top, bottom),
+                                   sign_by_form(expr.base) == POSITIVE)
         return power(top, abs(k), n), power(bottom, abs(k), n)
     return polynomial(expr, states), constant(1, n)
 
 
-def _divided(a: tuple[Polynomial, Polynomial],
-             b: tuple[Polynomial, Polynomial]) -> tuple[Polynomial, Polynomial]:
-    """a / b, where b's numerator is a nonzero number or evidently positive."""
+def _divided(a: tuple[Polynomial, Polynomial], b: tuple[Polynomial, Polynomial],
+             positive: bool = False) -> tuple[Polynomial, Polynomial]:
+    """a / b, where b's numerator is a nonzero number or evidently positive, or where b
+    is positive at every point by its form (`positive`): b = N / D with D > 0, so N > 0."""
     if len(b[0]) == 1 and all(k == 0 for k in next(iter(b[0]))):  # by a number c != 0
         return scale(multiply(a[0], b[1]), 1 / next(iter(b[0].values()))), a[1]
-    if not evidently_positive(b[0]):
+    if not (positive or evidently_positive(b[0])):
         raise NotPolynomial("a divisor that is not evidently positive")
     return multiply(a[0], b[1]), multiply(a[1], b[0])
+
+
+UNKNOWN, NONNEGATIVE, POSITIVE = 0, 1, 2
+
+
+def sign_by_form(expr: E.Expr) -> int:
+    """What an expression's form alone shows of its sign at every point: POSITIVE for
+    1 + (1 + y)^2 (a positive number plus even powers), NONNEGATIVE for (x - y)^2,
+    UNKNOWN otherwise (the expanded y^2 + 2 y + 2 is not `evidently_positive`)."""
+    if isinstance(expr, E.Num):
+        return POSITIVE if expr.value > 0 else NONNEGATIVE if expr.value == 0 else UNKNOWN
+    if isinstance(expr, E.Pow) and isinstance(expr.exponent, E.Num) \
+            and expr.exponent.value.denominator == 1:
+        base, even = sign_by_form(expr.base), expr.exponent.value % 2 == 0
+        if expr.exponent.value < 0:  # 1 / b^k: defined only where b != 0
+            return POSITIVE if base == POSITIVE else UNKNOWN
+        return max(base, NONNEGATIVE) if even else base
+    if isinstance(expr, E.Add):
+        signs = [sign_by_form(t) for t in expr.terms]
+        return UNKNOWN if UNKNOWN in signs else max(signs)
+    if isinstance(expr, (E.Mul, E.Div)):
+        signs = [sign_by_form(f) for f in E.children(expr)]
+        return min(signs)
+    return UNKNOWN
 
 
 def evidently_positive(p: Mapping[Monomial, Fraction]) -> bool:
