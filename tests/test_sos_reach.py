@@ -301,3 +301,17 @@ def test_a_stand_in_keeps_polynomial_components_and_fits_the_others():
     assert error <= 2 * TOLERANCE and all(m[1] == 0 for m in fitted[1])
     # exp(4 x) on [-2, 2] (up to e^8): no fit of degree 7 is within the tolerance
     assert polynomial_field([y, E.apply("exp", E.mul(E.Num(4), x))], states, domain) is None
+
+
+def test_a_map_with_sin_is_solved_for_a_polynomial_stand_in():
+    """probe44/y16, a 4-state sine ring map's reach (I's corner lies further out than
+    D's faces, so no ball round the origin works; learning failed since session 44):
+    the program, solved for a cubic stand-in for the map, gives a quadratic V off the
+    origin, proved for the true map through polynomial facts about sin."""
+    spec = fossil_dsl.load(ROOT / "specs/probe44/y16_sin_ring_map_reach_4d.fsl")
+    assert sos_reach.applies(compile_spec(spec))
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert "polynomial stand-in of degree 3" in result.strategy, result.strategy
+    V = result.sympy["V"]
+    assert sympy.Poly(V, *sorted(V.free_symbols, key=str)).total_degree() == 2

@@ -53,6 +53,10 @@ from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 FORMS = ("reach while avoid", "reach", "reach-avoid-remain", "reach and stay while avoid")
 DISCRETE_FORMS = ("reach while avoid", "reach")
 HALF_DEGREES = (1, 2)  # V of degree 2, then 4
+STAND_IN_DEGREES, MAP_STAND_IN_DEGREES = (3, 5, 7), (3, 5)
+# LQR gains tried with a stand-in, at most: where it works the first or second gain did
+# (19 specs with inputs), and probe36/r01's eight programs without a V took 8.5 s
+STAND_IN_CONTROLLERS = 3
 DECIMALS = 6  # kept of V's coefficients
 MIN_MARGIN = 1e-6
 # |coefficient| of V at most this: γ is absolute, so V must be free to be steep (a
@@ -93,13 +97,12 @@ class ReachFinding:
 
 def applies(plan: Plan) -> bool:
     """An ODE (polynomial, rational, or with a polynomial stand-in: surrogate.py), or a
-    polynomial map for reach and RWA (RAR's barrier program is for ODEs), a reach-type
-    property, the default templates, and at most a linear controller (the default one)."""
+    map for reach and RWA (RAR's barrier program is for ODEs), a reach-type property,
+    the default templates, and at most a linear controller (the default one)."""
     spec = plan.spec
     discrete = spec.time is TimeDomain.DISCRETE
     return (plan.certificate.form in (DISCRETE_FORMS if discrete else FORMS)
-            and default_synthesis(plan)
-            and (not discrete or all(traversal.is_arithmetic(f) for f in spec.dynamics)))
+            and default_synthesis(plan))
 
 
 def search(plan: Plan, deadline: float) -> ReachFinding | None:
@@ -114,19 +117,18 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     except Inexact:
         return None
     rng = np.random.default_rng(plan.options.seed)
-    box = spec.domain.bounding_box()
     discrete = spec.time is TimeDomain.DISCRETE
-    for controller, gain in lqr_controllers(plan, operating, rng):
+    for index, (controller, gain) in enumerate(lqr_controllers(plan, operating, rng)):
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
         field = _polynomial(closed, states)
         denominator, stand_in = P.constant(1, len(states)), 0
         if field is None:
-            found = None if discrete else _over_denominator(closed, plan, pieces)
+            found = _over_denominator(closed, plan, pieces, discrete)
             if found is None:
                 continue
             field, denominator, stand_in = found
-        if time.monotonic() > deadline:
-            continue
+        if time.monotonic() > deadline or stand_in and index >= STAND_IN_CONTROLLERS:
+            break
         found = _functions(len(states), field, denominator, pieces, deadline, discrete)
         if found is not None:
             formulas, levels, degree, margin = found
@@ -137,20 +139,27 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     return None
 
 
-def _over_denominator(closed, plan: Plan, pieces: _Pieces):
-    """(N, Q, the stand-in's degree) for an ODE that is not polynomial: a rational field
-    over one denominator Q > 0 (the programs are multiplied through by Q; RAR's barrier
-    program is for polynomial fields), else a polynomial stand-in over Q = 1; or None."""
-    states = plan.states
+def _over_denominator(closed, plan: Plan, pieces: _Pieces, discrete: bool):
+    """(N, Q, the stand-in's degree) for a system that is not polynomial: an ODE's
+    rational field over one denominator Q > 0 (the programs are multiplied through by Q;
+    RAR's barrier program is for polynomial fields), else a polynomial stand-in over
+    Q = 1, of lower degree for a map (V(p(x)) multiplies the degrees); or None."""
+    if discrete:
+        return _stand_in(closed, plan, MAP_STAND_IN_DEGREES)
     if all(traversal.is_arithmetic(f) for f in closed):
-        found = over_one_denominator(closed, states, plan.spec.domain.bounding_box(),
+        found = over_one_denominator(closed, plan.states, plan.spec.domain.bounding_box(),
                                      plan.options.seed)
         if found is not None:
             return None if pieces.outside_final is not None else (*found, 0)
-    field = polynomial_field(closed, states, plan.spec.domain, plan.options.seed)
+    return _stand_in(closed, plan, STAND_IN_DEGREES)
+
+
+def _stand_in(closed, plan: Plan, degrees):
+    field = polynomial_field(closed, plan.states, plan.spec.domain, plan.options.seed,
+                             degrees)
     if field is None:
         return None
-    return field, P.constant(1, len(states)), max(P.degree(p) for p in field)
+    return field, P.constant(1, len(plan.states)), max(P.degree(p) for p in field)
 
 
 def same_polynomial(first: E.Expr, second: E.Expr, states) -> bool:

@@ -1,7 +1,8 @@
 """A polynomial stand-in for a vector field with elementary functions (exp, sin, tanh,
 ...), for the sum-of-squares programs only: each component that is not a polynomial is
-replaced by its least-squares fit over samples of the domain, of the smallest degree in
-DEGREES whose largest sampled error is within TOLERANCE of the component's size.
+replaced by its least-squares fit over samples of the domain, of the smallest degree of
+those asked for (3, 5, 7 by default) whose largest sampled error is within TOLERANCE of
+the component's size.
 
 The programs then ask their conditions of the stand-in, with their margin as the only
 room for its error, so a function found with it may fail for the true field. Nothing
@@ -20,7 +21,6 @@ from fossil_dsl.engine.trajectories import column
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
 
-DEGREES = (3, 5, 7)
 SAMPLES = 4000
 # the largest sampled error allowed, relative to 1 + the component's largest sampled
 # magnitude: a Morse force -2 (1 - e^-x) e^-x on [-1, 3] needs degree 7 for it
@@ -29,9 +29,11 @@ MAX_TERMS = 120  # monomials of a fit, at most (degree 7 in 3 states)
 DIGITS = 8  # kept of each coefficient
 
 
-def polynomial_field(field, states, domain, seed: int = 0) -> list[P.Polynomial] | None:
-    """The field with each non-polynomial component fitted (module text), or None where
-    some component has no fit within the tolerance (or the domain has no samples)."""
+def polynomial_field(field, states, domain, seed: int = 0,
+                     degrees=(3, 5, 7)) -> list[P.Polynomial] | None:
+    """The field with each non-polynomial component fitted, of the first of `degrees`
+    within the tolerance, or None where some component has none (or the domain has no
+    samples)."""
     exact = [_exactly(f, states) for f in field]
     if all(p is not None for p in exact):
         return exact
@@ -46,7 +48,7 @@ def polynomial_field(field, states, domain, seed: int = 0) -> list[P.Polynomial]
             with np.errstate(all="ignore"):
                 values = column(evaluate(f, env), len(points))
             used = [k for k, s in enumerate(states) if s in E.free_vars(f)]
-            polynomial = _fit(points[:, used], values, used, len(states)) \
+            polynomial = _fit(points[:, used], values, used, len(states), degrees) \
                 if used and np.all(np.isfinite(values)) else None
             if polynomial is None:
                 return None
@@ -61,12 +63,12 @@ def _exactly(f, states) -> P.Polynomial | None:
         return None
 
 
-def _fit(points: np.ndarray, values: np.ndarray, used: list[int],
-         n: int) -> P.Polynomial | None:
+def _fit(points: np.ndarray, values: np.ndarray, used: list[int], n: int,
+         degrees) -> P.Polynomial | None:
     """The least-squares polynomial of the smallest degree within the tolerance, in the
     states `used` (the columns of `points`) out of n."""
     allowed = TOLERANCE * (1.0 + float(np.abs(values).max()))
-    for degree in DEGREES:
+    for degree in degrees:
         basis = P.monomials(len(used), 0, degree)
         if len(basis) > MAX_TERMS:
             return None
