@@ -293,14 +293,15 @@ def test_a_stand_in_keeps_polynomial_components_and_fits_the_others():
     states = ["x0", "x1"]
     domain = compile_spec(fossil_dsl.loads(STRAIGHT_THROUGH)).spec.domain  # [-2, 2]^2
     field = [y, E.neg(E.apply("sin", x))]
-    fitted = polynomial_field(field, states, domain)
+    fitted = polynomial_field(field, states, domain, sos_reach.STAND_IN_DEGREES)
     assert fitted[0] == {(0, 1): 1}  # exactly y
     grid = np.linspace(-2, 2, 41)
     error = max(abs(sum(float(c) * v ** m[0] * w ** m[1] for m, c in fitted[1].items())
                     + math.sin(v)) for v in grid for w in grid)
     assert error <= 2 * TOLERANCE and all(m[1] == 0 for m in fitted[1])
     # exp(4 x) on [-2, 2] (up to e^8): no fit of degree 7 is within the tolerance
-    assert polynomial_field([y, E.apply("exp", E.mul(E.Num(4), x))], states, domain) is None
+    steep = [y, E.apply("exp", E.mul(E.Num(4), x))]
+    assert polynomial_field(steep, states, domain, sos_reach.STAND_IN_DEGREES) is None
 
 
 def test_a_map_with_sin_is_solved_for_a_polynomial_stand_in():

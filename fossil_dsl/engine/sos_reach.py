@@ -155,8 +155,8 @@ def _over_denominator(closed, plan: Plan, pieces: _Pieces, discrete: bool):
 
 
 def _stand_in(closed, plan: Plan, degrees):
-    field = polynomial_field(closed, plan.states, plan.spec.domain, plan.options.seed,
-                             degrees)
+    field = polynomial_field(closed, plan.states, plan.spec.domain, degrees,
+                             plan.options.seed)
     if field is None:
         return None
     return field, P.constant(1, len(plan.states)), max(P.degree(p) for p in field)

@@ -1,8 +1,7 @@
 """A polynomial stand-in for a vector field with elementary functions (exp, sin, tanh,
 ...), for the sum-of-squares programs only: each component that is not a polynomial is
 replaced by its least-squares fit over samples of the domain, of the smallest degree of
-those asked for (3, 5, 7 by default) whose largest sampled error is within TOLERANCE of
-the component's size.
+those asked for whose largest sampled error is within TOLERANCE of the component's size.
 
 The programs then ask their conditions of the stand-in, with their margin as the only
 room for its error, so a function found with it may fail for the true field. Nothing
@@ -29,8 +28,7 @@ MAX_TERMS = 120  # monomials of a fit, at most (degree 7 in 3 states)
 DIGITS = 8  # kept of each coefficient
 
 
-def polynomial_field(field, states, domain, seed: int = 0,
-                     degrees=(3, 5, 7)) -> list[P.Polynomial] | None:
+def polynomial_field(field, states, domain, degrees, seed: int = 0):
     """The field with each non-polynomial component fitted, of the first of `degrees`
     within the tolerance, or None where some component has none (or the domain has no
     samples)."""
@@ -41,19 +39,19 @@ def polynomial_field(field, states, domain, seed: int = 0,
                                domain.bounding_box()), dtype=float)
     if len(points) < SAMPLES // 2:
         return None
-    env = state_env(states, points)
-    fitted = []
-    for f, polynomial in zip(field, exact):
-        if polynomial is None:
-            with np.errstate(all="ignore"):
-                values = column(evaluate(f, env), len(points))
-            used = [k for k, s in enumerate(states) if s in E.free_vars(f)]
-            polynomial = _fit(points[:, used], values, used, len(states), degrees) \
-                if used and np.all(np.isfinite(values)) else None
-            if polynomial is None:
-                return None
-        fitted.append(polynomial)
-    return fitted
+    fitted = [p if p is not None else _fitted(f, states, points, degrees)
+              for f, p in zip(field, exact)]
+    return None if any(p is None for p in fitted) else fitted
+
+
+def _fitted(f, states, points: np.ndarray, degrees) -> P.Polynomial | None:
+    """f's fit in the states it uses, or None (no fit, or f not finite at a sample)."""
+    with np.errstate(all="ignore"):
+        values = column(evaluate(f, state_env(states, points)), len(points))
+    used = [k for k, s in enumerate(states) if s in E.free_vars(f)]
+    if not used or not np.all(np.isfinite(values)):
+        return None
+    return _fit(points[:, used], values, used, len(states), degrees)
 
 
 def _exactly(f, states) -> P.Polynomial | None:
