@@ -1,6 +1,6 @@
 """Comparisons with divisions by evidently positive polynomials (y / (1 + z^2)) get a
 polynomial form, N >= 0 for N / D with D > 0 everywhere, so that a sum-of-squares
-refutation proves them (ir/polynomials.py `over_positive`, positivstellensatz.py); and a
+refutation proves them (ir/rational.py `over_positive`, positivstellensatz.py); and a
 race's point that is no counterexample leaves the query undecided, not failed."""
 import json
 from fractions import Fraction as F
@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir import rational as R
 from fossil_dsl.ir import traversal
 from fossil_dsl.kernel.obligations import Obligation
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES, discharge
@@ -47,7 +48,7 @@ rationals = st.fractions(min_value=-3, max_value=3, max_denominator=50)
 @settings(max_examples=60, deadline=None)
 @given(rationals, rationals, rationals)
 def test_the_form_is_the_expression_over_a_positive_denominator(x, y, z):
-    top, bottom = P.over_positive(RATIONAL, STATES)
+    top, bottom = R.over_positive(RATIONAL, STATES)
     point = (x, y, z)
     denominator = _at(bottom, point)
     assert denominator >= bottom[(0, 0, 0)] > 0  # evidently positive
@@ -62,9 +63,14 @@ def test_the_form_is_the_expression_over_a_positive_denominator(x, y, z):
     E.add(E.Num(1), E.neg(E.power(Z, E.Num(2)))),  # a negative coefficient
     E.add(E.Num(1), E.mul(X, Y)),  # an odd exponent
 ])
-def test_a_divisor_that_may_vanish_gives_no_polynomial_form(divisor):
+def test_a_divisor_that_may_vanish_multiplies_the_numerator(divisor):
+    """y / d >= 0 exactly where y * d >= 0, wherever d != 0 (the kernel proves every
+    division defined where a condition is evaluated): no positive form, but a polynomial
+    one, y * d."""
     with pytest.raises(P.NotPolynomial):
-        P.numerator(E.div(Y, divisor), STATES)
+        R.over_positive(E.div(Y, divisor), STATES)
+    expected = P.multiply(P.polynomial(Y, STATES), P.polynomial(divisor, STATES))
+    assert R.numerator(E.div(Y, divisor), STATES) == expected
 
 
 def _decrease_query(scale: F) -> L.Formula:
@@ -125,13 +131,13 @@ def test_an_undecided_condition_is_not_reported_as_failing():
 
 def test_a_division_by_a_negative_number_beside_a_positive_divisor_keeps_its_sign():
     expr = E.add(E.div(Y, ONE_PLUS_Z2), E.Div(X, E.Num(-2)))  # y/(1 + z^2) - x/2
-    top, bottom = P.over_positive(expr, STATES)
+    top, bottom = R.over_positive(expr, STATES)
     assert P.evidently_positive(bottom)
     for point in [(F(1), F(0), F(0)), (F(0), F(1), F(2)), (F(-3), F(1, 2), F(1))]:
         x, y, z = point
         assert _at(top, point) / _at(bottom, point) == y / (1 + z * z) - x / 2
     with pytest.raises(P.NotPolynomial):  # a divisor that is 0 gives no form
-        P.over_positive(E.add(E.div(Y, ONE_PLUS_Z2), E.Div(X, E.Num(0))), STATES)
+        R.over_positive(E.add(E.div(Y, ONE_PLUS_Z2), E.Div(X, E.Num(0))), STATES)
 
 
 def test_a_rational_condition_proved_by_a_solver_is_rechecked_by_a_refutation():
@@ -158,7 +164,7 @@ def test_a_divisor_positive_by_its_form_gives_a_polynomial_form(divisor):
     """The repressilator's 2 / (1 + (1 + y)^2) (probe55/p01): expanded, the divisor has an
     odd monomial, but its form (a positive number plus an even power) shows it positive."""
     expression = E.div(Y, divisor)
-    top, bottom = P.over_positive(expression, STATES)
+    top, bottom = R.over_positive(expression, STATES)
     for point in [(F(1), F(-2), F(-1)), (F(-3, 2), F(1, 3), F(5, 7)), (F(0), F(0), F(-1))]:
         assert _at(bottom, point) > 0
         folded = traversal.substitute(expression, dict(zip(STATES, map(E.Num, point))))
@@ -188,14 +194,40 @@ def forms(draw, depth: int = 3):
 def test_what_the_form_shows_of_the_sign_holds_at_every_point(expression, x, y, z):
     """Soundness of `sign_by_form`: POSITIVE means > 0 wherever the expression is
     defined, NONNEGATIVE >= 0."""
-    sign = P.sign_by_form(expression)
+    sign = R.sign_by_form(expression)
     try:
         folded = traversal.substitute(expression, {"x": E.Num(x), "y": E.Num(y), "z": E.Num(z)})
     except (E.ExprError, ZeroDivisionError):
         return  # undefined at the point
     if not isinstance(folded, E.Num):
         return
-    if sign == P.POSITIVE:
+    if sign == R.POSITIVE:
         assert folded.value > 0, (expression, folded)
-    if sign == P.NONNEGATIVE:
+    if sign == R.NONNEGATIVE:
         assert folded.value >= 0, (expression, folded)
+
+
+@settings(max_examples=300, deadline=None)
+@given(forms(), forms(), rationals, rationals, rationals)
+def test_the_polynomial_form_has_the_sign_of_the_expression_where_it_is_defined(
+        top, bottom, x, y, z):
+    """Soundness of `numerator`, which a refutation of a comparison with divisions
+    rests on: at every point where the expression is defined, the polynomial has its
+    sign (0 included)."""
+    expression = E.add(top, E.div(E.Num(1), E.add(bottom, E.Num(F(1, 3)))))
+    point = (x, y, z)
+    try:
+        form = R.numerator(expression, STATES)
+        folded = traversal.substitute(expression, dict(zip(STATES, map(E.Num, point))))
+    except (P.NotPolynomial, E.ExprError, ZeroDivisionError):
+        return  # no form (a division by 0 folded in), or undefined at the point
+    if not isinstance(folded, E.Num):
+        return
+    value = _at(form, point)
+    assert (value > 0) == (folded.value > 0) and (value == 0) == (folded.value == 0), \
+        (expression, point, value, folded.value)
+    quotient = R.quotient(expression, STATES)
+    divisor = _at(quotient.divisor(len(STATES)), point)
+    assert divisor != 0 and _at(quotient.top, point) / divisor == folded.value
+    if quotient.positive():
+        assert divisor > 0, (expression, point)

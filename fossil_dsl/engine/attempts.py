@@ -13,7 +13,7 @@ import numpy as np
 from dataclasses import replace
 
 from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos, sos_reach,
-                               torch_import)
+                               sos_roa, torch_import)
 from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, only_function, prove_found,
                                        verify_given)
@@ -55,6 +55,7 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
                              (repelling.applies, _repelling),
                              (sos.applies, _sum_of_squares),
                              (quadratic_roa.applies, _quadratic_region),
+                             (sos_roa.applies, _region_sum_of_squares),
                              (sos_reach.applies, _reach_sum_of_squares)):
         if backend is not None and applies(plan):
             found, note = attempt(plan, backend, listener, deadline)
@@ -179,14 +180,37 @@ def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
     budget = time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
     note = "no quadratic V of the linearisation decreases where it holds I"
     for finding in itertools.islice(quadratic_roa.candidates(plan, budget), QUADRATIC_TRIES):
-        lemma = _lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
-        for attempt in _lemma_then_own(lemma, plan):
-            found, note = prove_found(attempt, backend, listener, deadline, finding,
-                                      REACH_REFUTING_SECONDS, formulas=finding.formulas,
-                                      prepare=functools.partial(_set_up, finding=finding))
-            if found is not None:
-                return found, ""
+        found, note = _region_proved(plan, backend, listener, deadline, finding,
+                                     REACH_REFUTING_SECONDS)
+        if found is not None:
+            return found, ""
     return None, note
+
+
+def _region_proved(plan: Plan, backend: Backend, listener, deadline: float, finding,
+                   refuting: float):
+    """(plan with V given, β fixed and the controller set, certified outcome) or None,
+    and what happened: proved with the Taylor lemma's ball, else with the plan's own."""
+    lemma = _lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
+    note = ""
+    for attempt in _lemma_then_own(lemma, plan):
+        found, note = prove_found(attempt, backend, listener, deadline, finding, refuting,
+                                  formulas=finding.formulas,
+                                  prepare=functools.partial(_set_up, finding=finding))
+        if found is not None:
+            return found, ""
+    return None, note
+
+
+def _region_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with V given, β fixed and the controller set, certified outcome) or None,
+    what happened)."""
+    finding = _program_finding(plan, listener, "sum-of-squares program (region of attraction)",
+                               sos_roa.search)
+    if finding is None:
+        return None, "no sum-of-squares region of attraction found"
+    return _region_proved(plan, backend, listener, deadline, finding,
+                          max(REACH_REFUTING_SECONDS, 2 * finding.seconds))
 
 
 def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
@@ -221,12 +245,17 @@ def _lemma_ball(plan: Plan, finding) -> Plan | None:
     return None if radius is None else replace(plan, origin_radius=radius)
 
 
+def _program_finding(plan: Plan, listener, phase: str, search):
+    """What a program's search finds within the sum-of-squares budget (or None)."""
+    listener.phase(0, phase)
+    return search(plan, time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout))
+
+
 def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
     """((plan with V (and B) given and the controller set, certified outcome) or None,
     what happened)."""
-    listener.phase(0, "sum-of-squares program (reach)")
-    budget = min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
-    finding = sos_reach.search(plan, time.monotonic() + budget)
+    finding = _program_finding(plan, listener, "sum-of-squares program (reach)",
+                               sos_reach.search)
     if finding is None:
         return None, "no sum-of-squares reach certificate found"
     # for a stand-in's V the conditions with elementary functions are proved by the

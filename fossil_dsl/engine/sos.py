@@ -159,6 +159,12 @@ def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:
                           for i, k in opposite_pairs(constraints)]
 
 
+def faces(domain: list[P.Polynomial]) -> list[list[P.Polynomial]]:
+    """Each face {g = 0} of the domain {every g >= 0}, within the domain."""
+    return [[g, P.scale(g, -1)] + interval_products(domain[:k] + domain[k + 1:])
+            for k, g in enumerate(domain)]
+
+
 class _LyapunovProgram(Program):
     def __init__(self, n: int, field: list[P.Polynomial], constraints: list[P.Polynomial],
                  degree: int, power: int, discrete: bool):

@@ -36,7 +36,7 @@ import numpy as np
 from fossil_dsl.engine.linear import operating_point
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.sos import Inexact, interval_products, set_constraints
+from fossil_dsl.engine.sos import Inexact, faces, interval_products, set_constraints
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
 from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import expr as E
@@ -208,9 +208,7 @@ class _Pieces:
         self.stay = _StayPieces(self, goal, plan) if staying else None
 
     def faces(self) -> list[list[P.Polynomial]]:
-        """Each face {g = 0} of the domain, within the domain."""
-        return [[g, P.scale(g, -1)] + interval_products(self.domain[:k] + self.domain[k + 1:])
-                for k, g in enumerate(self.domain)]
+        return faces(self.domain)
 
     def outside(self, region, states) -> list[list[P.Polynomial]]:
         """D outside the region's interior: {g <= 0} within D, one piece per g."""
@@ -302,9 +300,7 @@ class _ReachProgram(Program):
                  discrete: bool):
         super().__init__(n)
         self.basis = P.monomials(n, 0, 2 * half)
-        self.coefficients = [self.scalar() for _ in self.basis]
-        for variable in self.coefficients:
-            self.at_most += [({variable: 1.0}, BOUND), ({variable: -1.0}, BOUND)]
+        self.coefficients = self.unknown_polynomial(self.basis, BOUND)
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))
         terms = [{m: Fraction(1)} for m in self.basis]
@@ -333,16 +329,9 @@ class _ReachProgram(Program):
         return {} if self.beta is None else {"beta": decimal(x[self.beta], DECIMALS)}
 
     def require(self, terms, constraints, constant=None) -> None:
-        """sum of terms (+ constant) - e = s + sum_i sigma_i g_i, as one identity."""
-        for variable, polynomial in terms:
-            self.add_term(variable, polynomial)
-        if constant:
-            self.add_constant(constant)
-        self.add_term(self.margin, P.constant(-1, self.n))
-        top = max([2, P.degree(constant or {})] + [P.degree(p) for _, p in terms]
-                  + [P.degree(g) for g in constraints])
-        self.minus_certificate((top + 1) // 2, constraints, low=0)
-        self.new_identity()
+        """sum of terms (+ constant) - e >= 0 on the piece."""
+        self.require_nonnegative(terms, constraints, (self.margin, P.constant(1, self.n)),
+                                 constant)
 
     def exact_v(self, x) -> P.Polynomial:
         return P.add(*({m: decimal(x[v], DECIMALS)} for m, v in zip(self.basis,

@@ -34,6 +34,7 @@ from typing import Sequence
 
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.rational import numerator
 from fossil_dsl.ir.expr import add, neg
 from fossil_dsl.solvers.atom_facts import abstracted, has_atoms
 
@@ -136,7 +137,7 @@ def comparisons(query: L.Formula, states: Sequence[str]) -> list[tuple[P.Polynom
             raise ValueError(f"not an inequality: {atom}")
         larger, smaller = (atom.left, atom.right) if atom.relation in (">", ">=") \
             else (atom.right, atom.left)
-        found.append((P.numerator(add(larger, neg(smaller)), states),
+        found.append((numerator(add(larger, neg(smaller)), states),
                       atom.relation in ("<", ">")))
     if not found:
         raise ValueError("the query has no comparison among its conjuncts")

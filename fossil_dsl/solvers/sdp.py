@@ -9,6 +9,7 @@ it requires (SCS, OSQP, HiGHS) add 230 MB to the install, Clarabel alone 3 MB.
 from __future__ import annotations
 
 import math
+import time
 from fractions import Fraction
 from typing import Callable
 
@@ -23,6 +24,14 @@ from fossil_dsl.ir import polynomials as P
 # and ten of 55 (5e11) took 118 s against a time limit of 20 s; the rate is set for a
 # usual machine (programs up to 4 times over the limit there are not tried)
 CUBED_ENTRIES_PER_SECOND = 1e10
+# Clarabel's factorisations in turn: its default (faer here: multithreaded, the fastest
+# by far on large programs, a 5-state quartic region of attraction in 37 s against
+# qdldl's 214), then, where that stops with a numerical error, qdldl (the 3-state
+# quartic of tests/test_sos_roa.py: faer's error, qdldl's solution in 0.7 s)
+SOLVE_METHODS = ("auto", "qdldl")
+# the second gets at most this times the first one's time: a program the first found
+# hard in 20 s is not worth the rest of an attempt's budget (the next gain or degree is)
+RETRY_SHARE = 2.0
 
 
 class Program:
@@ -64,6 +73,29 @@ class Program:
             if room >= low:
                 self.gram(P.monomials(self.n, low, room),
                           lambda p, g=g: P.scale(P.multiply(p, g), -1))
+
+    def require_nonnegative(self, terms, constraints: list[P.Polynomial],
+                            margin: tuple[int, P.Polynomial], constant=None) -> None:
+        """sum of variable * polynomial terms (+ constant) - margin variable * its
+        polynomial = s + sum_i sigma_i g_i, as one identity: the left side is then >= 0
+        wherever every g_i >= 0."""
+        for variable, polynomial in terms:
+            self.add_term(variable, polynomial)
+        if constant:
+            self.add_constant(constant)
+        self.add_term(margin[0], P.scale(margin[1], -1))
+        top = max([2, P.degree(constant or {}), P.degree(margin[1])]
+                  + [P.degree(p) for _, p in terms] + [P.degree(g) for g in constraints])
+        self.minus_certificate((top + 1) // 2, constraints, low=0)
+        self.new_identity()
+
+    def unknown_polynomial(self, basis: list[P.Monomial], bound: float) -> list[int]:
+        """A scalar per monomial of the basis, each in [-bound, bound]: the coefficients
+        of a polynomial the program looks for."""
+        coefficients = [self.scalar() for _ in basis]
+        for variable in coefficients:
+            self.at_most += [({variable: 1.0}, bound), ({variable: -1.0}, bound)]
+        return coefficients
 
     def scalar(self) -> int:
         self.count += 1
@@ -120,11 +152,19 @@ class Program:
         q = np.zeros(self.count)
         for variable, weight in objective.items():
             q[variable] = weight
-        settings = clarabel.DefaultSettings()
-        settings.verbose = False
-        settings.time_limit = max(0.1, seconds)
-        solution = clarabel.DefaultSolver(sparse.csc_matrix((self.count, self.count)), q, A,
-                                          np.array(right), cones, settings).solve()
+        limit = seconds
+        for method in SOLVE_METHODS:
+            settings = clarabel.DefaultSettings()
+            settings.verbose = False
+            settings.direct_solve_method = method
+            settings.time_limit = max(0.1, limit)
+            started = time.monotonic()
+            solution = clarabel.DefaultSolver(sparse.csc_matrix((self.count, self.count)), q,
+                                              A, np.array(right), cones, settings).solve()
+            if str(solution.status) != "NumericalError":
+                break
+            spent = time.monotonic() - started
+            limit = min(seconds - spent, RETRY_SHARE * spent)
         if str(solution.status) not in ("Solved", "AlmostSolved"):
             return None
         return np.array(solution.x)
