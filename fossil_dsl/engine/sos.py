@@ -159,6 +159,13 @@ def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:
                           for i, k in opposite_pairs(constraints)]
 
 
+def rounded(x, basis: list[P.Monomial], coefficients: list[int],
+            decimals: int) -> P.Polynomial:
+    """The polynomial a program found (its coefficients' values in x), each coefficient
+    rounded to `decimals` decimals."""
+    return P.add(*({m: decimal(x[c], decimals)} for m, c in zip(basis, coefficients)))
+
+
 def faces(domain: list[P.Polynomial]) -> list[list[P.Polynomial]]:
     """Each face {g = 0} of the domain {every g >= 0}, within the domain."""
     return [[g, P.scale(g, -1)] + interval_products(domain[:k] + domain[k + 1:])
@@ -173,7 +180,7 @@ class _LyapunovProgram(Program):
         change = lambda p: P.change(p, field, discrete)  # dV/dt or V(f(x)) - V(x)
         self.z = P.monomials(n, 1, degree)
         self.states_block = self.z[:n]  # the linear monomials come first
-        norm = _squared_norm(n)
+        norm = squared_norm(n)
         self.v_entries = self.gram(self.z, lambda p: P.scale(change(p), -1))  # -dV, part by part
         self.add_constant(P.scale(change(P.scale(norm, V_FLOOR)), -1))
         self.margin = self.scalar()
@@ -196,14 +203,14 @@ class _LyapunovProgram(Program):
 
     def exact_v(self, x) -> P.Polynomial:
         """z^T P z + e|x|^2 with P's entries rounded to DECIMALS decimals."""
-        terms = [P.scale(_squared_norm(self.n), V_FLOOR)]
+        terms = [P.scale(squared_norm(self.n), V_FLOOR)]
         for variable, i, j in self.v_entries:
             weight = decimal(x[variable], DECIMALS) * (1 if i == j else 2)
             terms.append({P.times(self.z[i], self.z[j]): weight})
         return P.add(*terms)
 
 
-def _squared_norm(n: int) -> P.Polynomial:
+def squared_norm(n: int) -> P.Polynomial:
     return {tuple(int(k == i) * 2 for k in range(n)): Fraction(1) for i in range(n)}
 
 

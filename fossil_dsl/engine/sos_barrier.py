@@ -21,8 +21,7 @@ from fractions import Fraction
 
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.sos import MIN_MARGIN, SosFinding, field_of, set_constraints
-from fossil_dsl.solvers.gram_rounding import decimal
+from fossil_dsl.engine.sos import MIN_MARGIN, SosFinding, field_of, rounded, set_constraints
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.sets import Intersection
@@ -82,9 +81,7 @@ class BarrierProgram(Program):
                  mu: float, denominator: P.Polynomial | None = None):
         super().__init__(n)
         self.basis = P.monomials(n, 0, 2 * degree)
-        self.coefficients = [self.scalar() for _ in self.basis]
-        for variable in self.coefficients:  # -1 <= b <= 1
-            self.at_most += [({variable: 1.0}, 1.0), ({variable: -1.0}, 1.0)]
+        self.coefficients = self.unknown_polynomial(self.basis, 1.0)  # -1 <= b <= 1
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))
         b_terms = [{m: Fraction(1)} for m in self.basis]
@@ -101,13 +98,8 @@ class BarrierProgram(Program):
         self._condition(flow, domain)
 
     def _condition(self, terms, constraints) -> None:
-        """sum of terms - e = s + sum_i sigma_i g_i, as one identity."""
-        for variable, polynomial in terms:
-            self.add_term(variable, polynomial)
-        self.add_term(self.margin, P.constant(-1, self.n))
-        top = max([2] + [P.degree(p) for _, p in terms] + [P.degree(g) for g in constraints])
-        self.minus_certificate((top + 1) // 2, constraints, low=0)
-        self.new_identity()
+        """sum of terms - e >= 0 on the piece."""
+        self.require_nonnegative(terms, constraints, (self.margin, P.constant(1, self.n)))
 
     def exact_b(self, x) -> P.Polynomial:
-        return P.add(*({m: decimal(x[v], DECIMALS)} for m, v in zip(self.basis, self.coefficients)))
+        return rounded(x, self.basis, self.coefficients, DECIMALS)

@@ -36,7 +36,7 @@ import numpy as np
 from fossil_dsl.engine.linear import operating_point
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.sos import Inexact, faces, interval_products, set_constraints
+from fossil_dsl.engine.sos import Inexact, faces, interval_products, rounded, set_constraints
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
 from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import expr as E
@@ -334,5 +334,4 @@ class _ReachProgram(Program):
                                  constant)
 
     def exact_v(self, x) -> P.Polynomial:
-        return P.add(*({m: decimal(x[v], DECIMALS)} for m, v in zip(self.basis,
-                                                                   self.coefficients)))
+        return rounded(x, self.basis, self.coefficients, DECIMALS)

@@ -31,13 +31,13 @@ import numpy as np
 
 from fossil_dsl.engine.linear import operating_point
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
-from fossil_dsl.engine.sos import Inexact, faces, interval_products, set_constraints
-from fossil_dsl.engine.sos_reach import DECIMALS, MIN_MARGIN, BOUND, ReachFinding
+from fossil_dsl.engine.sos import (Inexact, faces, interval_products, rounded, set_constraints,
+                                   squared_norm)
+from fossil_dsl.engine.sos_reach import BOUND, DECIMALS, MIN_MARGIN, ReachFinding
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan, default_synthesis
-from fossil_dsl.solvers.gram_rounding import decimal
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 
@@ -102,7 +102,7 @@ class _RegionProgram(Program):
         terms = [{m: Fraction(1)} for m in self.basis]
         v = list(zip(self.coefficients, terms))
         minus_v = [(c, P.scale(t, -1)) for c, t in v]
-        norm = {tuple(2 * (k == i) for k in range(n)): Fraction(1) for i in range(n)}
+        norm = squared_norm(n)
         one = P.constant(1, n)
         inside = interval_products(domain)
         self.require_nonnegative(v, inside, (self.margin, norm))
@@ -113,5 +113,4 @@ class _RegionProgram(Program):
         self.require_nonnegative(decrease, inside, (self.margin, norm))
 
     def exact_v(self, x) -> P.Polynomial:
-        return P.add(*({m: decimal(x[c], DECIMALS)} for m, c in zip(self.basis,
-                                                                   self.coefficients)))
+        return rounded(x, self.basis, self.coefficients, DECIMALS)
