@@ -2,13 +2,18 @@
 quadratic V of the linearisation has a sublevel set between I and D (a chain of
 integrators: the closed loop keeps no such ellipsoid), a V of the program is proved by
 the kernel; an unstable system gets none."""
+import functools
 import time
 
 import pytest
 
 import fossil_dsl
 from fossil_dsl.engine import sos_roa
+from fossil_dsl.engine.attempts import _set_up
+from fossil_dsl.engine.loop import as_listener
+from fossil_dsl.engine.proving import prove_found
 from fossil_dsl.plan.compile import compile_spec
+from fossil_dsl.solvers import registry
 
 # four integrators with a cubic drag, I a ball of 0.4 in the unit box: the ellipsoid
 # program of ellipsoid_seed.py is infeasible at every decay rate, and learning ran out of
@@ -64,6 +69,21 @@ def test_a_chain_of_integrators_gets_its_region_from_the_program(text, degree):
         result.strategy
     assert result.learn_seconds < 0.01
     assert "converges to the origin" in result.kernel.guarantee
+
+
+def test_the_found_v_is_refuted_for_the_closed_loop():
+    """The refutations of a found V's obligations are of the closed loop: before session
+    57 they were asked of the open loop (the input a free variable), so no condition on
+    the field was ever refuted there, and probe56/u02's solvers ran out of time."""
+    plan = compile_spec(fossil_dsl.loads(CHAIN))
+    finding = sos_roa.search(plan, time.monotonic() + 60)
+    assert finding is not None and finding.controller
+    found, note = prove_found(plan, registry.load(plan.verifier), as_listener(None),
+                              time.monotonic() + 120, finding, 60.0, query_seconds=0.001,
+                              formulas=finding.formulas,
+                              prepare=functools.partial(_set_up, finding=finding))
+    assert found is not None, note  # the solvers had no time: the refutations did it
+    assert found[1].refutations.keys() >= {"condition:decrease", "condition:boundary"}
 
 
 def test_an_unstable_system_gets_no_region():

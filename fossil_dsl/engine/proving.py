@@ -84,8 +84,8 @@ def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
     settle every condition."""
     started = time.monotonic()
     candidate = cegis.exact_candidate()
-    claim = Claim(plan.spec, dict(candidate.formulas), {}, dict(candidate.levels),
-                  plan.origin_radius)
+    claim = Claim(plan.spec, dict(candidate.formulas), dict(candidate.controller),
+                  dict(candidate.levels), plan.origin_radius)
     refutations = {}
     for obligation in list_obligations(claim):
         found = refute(obligation.query, plan.states, deadline)
