@@ -151,3 +151,38 @@ def test_a_union_bounds_its_variables_by_the_hull_of_its_parts():
         is Status.UNSAT
     # points of the strip have x <= -1.5: not refuted
     assert check(union, L.Compare("<=", x, num(Fraction(-3, 2)))) is not Status.UNSAT
+
+
+def _quadratic(matrix, centre) -> E.Expr:
+    """(v - c)^T A (v - c) over x, y as an expression."""
+    shifted = [E.add(v, num(-c)) for v, c in zip((x, y), centre)]
+    return E.add(*(E.mul(num(matrix[i][j]), shifted[i], shifted[j])
+                   for i in range(2) for j in range(2)))
+
+
+ENTRY = st.fractions(min_value=-3, max_value=3, max_denominator=16)
+
+
+@settings(max_examples=60, deadline=None)
+@given(ENTRY, ENTRY, ENTRY, ENTRY, ENTRY, st.fractions(min_value="1/16", max_value=4,
+                                                       max_denominator=16))
+def test_an_ellipsoid_with_cross_terms_bounds_its_variables_soundly_and_tightly(
+        a, b, c, cx, cy, radius):
+    # A = L L^T with L = [[1 + |a|, 0], [b, 1 + |c|]]: positive definite
+    l11, l21, l22 = 1 + abs(a), b, 1 + abs(c)
+    A = [[l11 ** 2, l11 * l21], [l11 * l21, l21 ** 2 + l22 ** 2]]
+    found = starting_box(L.Compare("<=", _quadratic(A, (cx, cy)), num(radius)), ["x", "y"])
+    assert found is not None
+    det = A[0][0] * A[1][1] - A[0][1] ** 2
+    for (low, high), centre, inverse_diagonal in zip(found, (cx, cy),
+                                                     (A[1][1] / det, A[0][0] / det)):
+        reach = float(radius * inverse_diagonal) ** 0.5  # the extreme point's offset
+        assert Fraction(low) <= centre - Fraction(reach) * (1 - Fraction(1, 10 ** 9))
+        assert Fraction(high) >= centre + Fraction(reach) * (1 - Fraction(1, 10 ** 9))
+        assert high - low <= 2 * reach * (1 + 1e-9) + 1e-12
+
+
+def test_a_quadratic_that_is_not_positive_definite_bounds_nothing():
+    saddle = _quadratic([[1, 2], [2, 1]], (0, 0))  # eigenvalues 3 and -1
+    assert starting_box(L.conjunction(L.Compare("<=", saddle, num(1)), *box(-5, 5, y)),
+                        ["x", "y"]) is None

@@ -23,6 +23,7 @@ from fossil_dsl.kernel import Claim
 from fossil_dsl.kernel.rules import lemma_radius
 from fossil_dsl.plan.compile import Plan, origin_radius, with_conditions
 from fossil_dsl.solvers.api import Backend
+from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES
 
 BASIN_SHARE = 0.3  # of the run's time, at most, for shaping V to the basin (region: largest)
 SOS_SHARE = 0.25  # of the run's time, at most, for the sum-of-squares attempt
@@ -36,6 +37,10 @@ BASIN_QUERY_SECONDS = 30.0
 # floor keeps hopeless ones short (g04: its quartic V's refutations took 40 s and failed;
 # a quadratic V's are found in well under a second)
 REACH_REFUTING_SECONDS = 5.0
+# the first quadratic V of a field with elementary functions: a larger program and more
+# time for its refutations (probe44/y12's decrease, 8 variables with sin and cos: 1035
+# Gram entries in s0 alone, refuted in 10 s; by bisection not in 60 s)
+QUADRATIC_REFUTING = (20.0, 3_000)  # (seconds, largest program)
 REPELLING_TRIES = 2  # barriers round a repelling equilibrium proved, at most
 QUADRATIC_TRIES = 2  # quadratic V of the linearisation proved, at most
 CONSERVED_REFINEMENTS = 3  # conserved-quantity barriers chosen again with counterexamples
@@ -179,23 +184,26 @@ def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
     listener.phase(0, "the linearisation's quadratic V")
     budget = time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
     note = "no quadratic V of the linearisation decreases where it holds I"
-    for finding in itertools.islice(quadratic_roa.candidates(plan, budget), QUADRATIC_TRIES):
+    for index, finding in enumerate(itertools.islice(quadratic_roa.candidates(plan, budget),
+                                                     QUADRATIC_TRIES)):
+        larger = index == 0 and plan.verifier != "z3"  # z3: a polynomial field
         found, note = _region_proved(plan, backend, listener, deadline, finding,
-                                     REACH_REFUTING_SECONDS)
+                                     *(QUADRATIC_REFUTING if larger else
+                                       (REACH_REFUTING_SECONDS, ATOMS_MAX_VARIABLES)))
         if found is not None:
             return found, ""
     return None, note
 
 
 def _region_proved(plan: Plan, backend: Backend, listener, deadline: float, finding,
-                   refuting: float):
+                   refuting: float, atoms_limit: int = ATOMS_MAX_VARIABLES):
     """(plan with V given, β fixed and the controller set, certified outcome) or None,
     and what happened: proved with the Taylor lemma's ball, else with the plan's own."""
     lemma = _lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
     note = ""
     for attempt in _lemma_then_own(lemma, plan):
         found, note = prove_found(attempt, backend, listener, deadline, finding, refuting,
-                                  formulas=finding.formulas,
+                                  formulas=finding.formulas, atoms_limit=atoms_limit,
                                   prepare=functools.partial(_set_up, finding=finding))
         if found is not None:
             return found, ""

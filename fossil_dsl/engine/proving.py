@@ -11,7 +11,7 @@ from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.api import Backend, Status
-from fossil_dsl.solvers.sos_refutation import refute
+from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, refute
 
 # per solver query on a found candidate, where no refutation settles a condition: a
 # candidate the solvers cannot prove at once is left to learning (bb25: an interval
@@ -37,13 +37,14 @@ def _verified_once(cegis: Cegis) -> CegisOutcome:
 
 def prove_found(plan: Plan, backend: Backend, listener, deadline: float, finding,
                 refuting_seconds: float, query_seconds: float = SOS_QUERY_SECONDS,
-                formulas: dict | None = None, prepare=None):
+                formulas: dict | None = None, prepare=None,
+                atoms_limit: int = ATOMS_MAX_VARIABLES):
     """((plan with the function given, certified outcome) or None, what happened)."""
     try:
         given, outcome = verify_given(plan, backend, listener, deadline,
                                       formulas or only_function(plan, finding.formula),
                                       query_seconds, time.monotonic() + refuting_seconds,
-                                      prepare)
+                                      prepare, atoms_limit)
     except NotSetUp as exc:
         return None, f"{finding.describe()}: {exc}"
     if not outcome.certified:
@@ -52,7 +53,8 @@ def prove_found(plan: Plan, backend: Backend, listener, deadline: float, finding
 
 
 def verify_given(plan: Plan, backend: Backend, listener, deadline: float, formulas,
-                 query_seconds: float, refuting_until: float | None = None, prepare=None):
+                 query_seconds: float, refuting_until: float | None = None, prepare=None,
+                 atoms_limit: int = ATOMS_MAX_VARIABLES):
     """The plan with the found functions (name -> formula) as its candidates, and its
     outcome: proved by refutations of the kernel's obligations where they settle every
     condition, else by the solvers; the
@@ -66,7 +68,7 @@ def verify_given(plan: Plan, backend: Backend, listener, deadline: float, formul
     if prepare is not None:
         prepare(cegis)
     listener.phase(0, "sum-of-squares refutations")
-    outcome = _refuted(given, cegis, refuting_until or deadline)
+    outcome = _refuted(given, cegis, refuting_until or deadline, atoms_limit)
     listener.finished(outcome.history[-1])
     if not outcome.certified:
         outcome = _merged(_verified_once(cegis), outcome.refutations)
@@ -78,7 +80,7 @@ def only_function(plan: Plan, formula) -> dict:
     return {f.name: formula for f in plan.functions}
 
 
-def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
+def _refuted(plan: Plan, cegis: Cegis, deadline: float, atoms_limit: int) -> CegisOutcome:
     """Sum-of-squares refutations of the kernel's obligations for the candidate, found
     numerically and rounded (the kernel checks them exactly); certified here when they
     settle every condition."""
@@ -88,7 +90,7 @@ def _refuted(plan: Plan, cegis: Cegis, deadline: float) -> CegisOutcome:
                   dict(candidate.levels), plan.origin_radius)
     refutations = {}
     for obligation in list_obligations(claim):
-        found = refute(obligation.query, plan.states, deadline)
+        found = refute(obligation.query, plan.states, deadline, atoms_limit)
         if found is not None:
             refutations[obligation.name] = found
     verdicts = _settled(tuple(Verdict(c.name, Status.UNKNOWN, "no refutation found")

@@ -52,10 +52,15 @@ def _conjuncts(formula: L.Formula) -> list[L.Formula]:
 
 
 def _bounds(atom: L.Formula, names):
-    """(variable, lower, upper) that the comparison implies: from `x <= c`, `c <= x`, and
-    an axis-parallel ellipsoid `sum a_i (x_i - c_i)^2 <= r`."""
+    """(variable, lower, upper) that the comparison implies: from `x <= c`, `c <= x`, an
+    axis-parallel ellipsoid `sum a_i (x_i - c_i)^2 <= r`, and any ellipsoid
+    `x^T A x + b^T x + k <= 0` with A positive definite (a sublevel set of a quadratic V)."""
     polynomial = _at_most_zero(atom, names)
-    return [] if polynomial is None else _ellipsoid_bounds(polynomial, names)
+    if polynomial is None:
+        return []
+    if _ellipsoid_parts(polynomial, names) is not None:
+        return _ellipsoid_bounds(polynomial, names)
+    return quadratic_bounds(polynomial, names)
 
 
 def _at_most_zero(atom: L.Formula, names) -> dict | None:
@@ -132,6 +137,66 @@ def _ellipsoid_bounds(polynomial: dict, names):
         reach = Fraction(sqrt_up(radius / a))
         found.append((names[i], _down(centre - reach), _up(centre + reach)))
     return found
+
+
+def quadratic_bounds(polynomial: dict, names):
+    """For p(x) = x^T A x + b^T x + k <= 0 over the variables p has, A positive definite
+    (shown exactly, by the pivots of its LDL^T factorisation): with c = -A^-1 b / 2 and
+    R = b^T A^-1 b / 4 - k, p <= 0 is (x - c)^T A (x - c) <= R, on which x_i - c_i
+    reaches at most sqrt(R (A^-1)_ii). [] for any other p."""
+    if any(sum(m) > 2 for m in polynomial):
+        return []
+    used = sorted({i for m in polynomial for i, k in enumerate(m) if k})
+    where = {v: row for row, v in enumerate(used)}
+    A = [[Fraction(0)] * len(used) for _ in used]
+    b, k = [Fraction(0)] * len(used), Fraction(0)
+    for monomial, coefficient in polynomial.items():
+        present = [i for i, e in enumerate(monomial) for _ in range(e)]
+        c = Fraction(coefficient)
+        if not present:
+            k = c
+        elif len(present) == 1:
+            b[where[present[0]]] = c
+        elif present[0] == present[1]:
+            A[where[present[0]]][where[present[0]]] = c
+        else:
+            i, j = where[present[0]], where[present[1]]
+            A[i][j] = A[j][i] = c / 2
+    inverse = _positive_definite_inverse(A)
+    if inverse is None:
+        return []
+    n = len(used)
+    centre = [-sum(inverse[i][j] * b[j] for j in range(n)) / 2 for i in range(n)]
+    radius = sum(b[i] * inverse[i][j] * b[j] for i in range(n) for j in range(n)) / 4 - k
+    if radius < 0:
+        return []
+    found = []
+    for row, v in enumerate(used):
+        reach = Fraction(sqrt_up(radius * inverse[row][row]))
+        found.append((names[v], _down(centre[row] - reach), _up(centre[row] + reach)))
+    return found
+
+
+def _positive_definite_inverse(A: list[list[Fraction]]) -> list[list[Fraction]] | None:
+    """A^-1 by Gauss-Jordan elimination without pivoting, in exact rationals, or None
+    unless every pivot is positive (for a symmetric A: positive definite)."""
+    n = len(A)
+    work = [row[:] + [Fraction(int(i == j)) for j in range(n)] for i, row in enumerate(A)]
+    for col in range(n):
+        pivot = work[col][col]
+        if pivot <= 0:
+            return None
+        for row in range(col + 1, n):
+            factor = work[row][col] / pivot
+            if factor:
+                work[row] = [a - factor * p for a, p in zip(work[row], work[col])]
+    for col in reversed(range(n)):
+        work[col] = [a / work[col][col] for a in work[col]]
+        for row in range(col):
+            factor = work[row][col]
+            if factor:
+                work[row] = [a - factor * p for a, p in zip(work[row], work[col])]
+    return [row[n:] for row in work]
 
 
 def sqrt_up(value: Fraction) -> float:

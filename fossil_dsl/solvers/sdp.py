@@ -49,19 +49,33 @@ class Program:
         self.equalities: list[tuple[dict[int, float], float]] = []
         self.at_most: list[tuple[dict[int, float], float]] = []  # coefficients . x <= bound
 
-    def gram(self, basis: list[P.Monomial], of: Callable[[P.Polynomial], P.Polynomial] = None):
+    def gram(self, basis: list[P.Monomial], of: Callable[[P.Polynomial], P.Polynomial] = None,
+             times: P.Polynomial | None = None, sign: int = 1):
         """A PSD block G over the basis, adding of(m^T G m) to the identity (`of` is linear:
-        m^T G m itself by default, a product with a polynomial, a derivative, nothing);
+        m^T G m itself by default, a derivative, nothing), or sign * m^T G m * times (a
+        multiplier's product with a constraint, in floats: each entry's term is a shifted
+        copy of `times`, which a product of Fractions built 20 times slower);
         returns [(variable, i, j)] for its upper triangle, column by column."""
         self.blocks.append((self.count, basis))
+        rows = None if times is None else [(m, sign * float(c)) for m, c in times.items() if c]
         entries = []
         for j in range(len(basis)):
             for i in range(j + 1):
-                product = {P.times(basis[i], basis[j]): Fraction(1 if i == j else 2)}
-                self.add_term(self.count, of(product) if of else product)
+                monomial, weight = P.times(basis[i], basis[j]), 1 if i == j else 2
+                if rows is None:
+                    product = {monomial: Fraction(weight)}
+                    self.add_term(self.count, of(product) if of else product)
+                else:
+                    self._add_shifted(self.count, monomial, weight, rows)
                 entries.append((self.count, i, j))
                 self.count += 1
         return entries
+
+    def _add_shifted(self, variable: int, monomial: P.Monomial, weight: int, rows) -> None:
+        """variable * weight * monomial * (the polynomial of `rows`) into the identity."""
+        for m, c in rows:
+            row = self.identity.setdefault((self.tag, P.times(monomial, m)), {})
+            row[variable] = row.get(variable, 0.0) + weight * c
 
     def minus_certificate(self, half: int, constraints: list[P.Polynomial], low: int) -> None:
         """Subtracts s + sum_i sigma_i g_i from the identity (so that what it holds is
@@ -71,8 +85,7 @@ class Program:
         for g in constraints:
             room = (2 * half - P.degree(g)) // 2
             if room >= low:
-                self.gram(P.monomials(self.n, low, room),
-                          lambda p, g=g: P.scale(P.multiply(p, g), -1))
+                self.gram(P.monomials(self.n, low, room), times=g, sign=-1)
 
     def require_nonnegative(self, terms, constraints: list[P.Polynomial],
                             margin: tuple[int, P.Polynomial], constant=None) -> None:

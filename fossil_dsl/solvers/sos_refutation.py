@@ -63,15 +63,17 @@ class SosBackend:
         return Answer(Status.UNSAT, solver=self.name, evidence=found)
 
 
-def refute(query: L.Formula, states, deadline: float) -> Evidence | None:
+def refute(query: L.Formula, states, deadline: float,
+           atoms_limit: int = ATOMS_MAX_VARIABLES) -> Evidence | None:
     """A refutation of the query that checks exactly (see the module's text), or None;
     where the conjuncts without a disjunction are not refuted, one of the query's
-    disjunctions case by case (a point on a box's boundary is on one of its faces)."""
-    found = _refuted_conjunction(query, states, deadline)
+    disjunctions case by case (a point on a box's boundary is on one of its faces).
+    `atoms_limit`: the largest program tried for a query with elementary functions."""
+    found = _refuted_conjunction(query, states, deadline, atoms_limit)
     if found is not None:
         return found
     for index in _disjunctions(query):
-        split = _refuted_cases(query, states, index, deadline)
+        split = _refuted_cases(query, states, index, deadline, atoms_limit)
         if split is not None or time.monotonic() > deadline:
             return split
     return None
@@ -89,10 +91,11 @@ def _disjunctions(query: L.Formula) -> list[int]:
     return [index for _, index in sorted(found)]
 
 
-def _refuted_cases(query: L.Formula, states, index: int, deadline: float) -> CaseSplit | None:
+def _refuted_cases(query: L.Formula, states, index: int, deadline: float,
+                   atoms_limit: int) -> CaseSplit | None:
     found = []
     for case in cases(query, index):
-        refutation = _refuted_conjunction(case, states, deadline)
+        refutation = _refuted_conjunction(case, states, deadline, atoms_limit)
         if refutation is None:
             return None
         found.append(refutation)
@@ -100,16 +103,17 @@ def _refuted_cases(query: L.Formula, states, index: int, deadline: float) -> Cas
     return split if refutation_problem(split, query, states) is None else None
 
 
-def _refuted_conjunction(query: L.Formula, states, deadline: float) -> Refutation | None:
+def _refuted_conjunction(query: L.Formula, states, deadline: float,
+                         atoms_limit: int = ATOMS_MAX_VARIABLES) -> Refutation | None:
     abstract = has_atoms(query)
-    if abstract and _least_abstracted_size(query, states) > ATOMS_MAX_VARIABLES:
+    if abstract and _least_abstracted_size(query, states) > atoms_limit:
         return None  # before abstracting and expanding: a tanh network's V has dozens
     query, states = polynomial_form(query, states)
     try:
         atoms = comparisons(query, states)
     except ValueError:
         return None
-    powers, limit = ((1,), ATOMS_MAX_VARIABLES) if abstract else (POWERS, MAX_VARIABLES)
+    powers, limit = ((1,), atoms_limit) if abstract else (POWERS, MAX_VARIABLES)
     bounds = None if abstract else opposite_bounds(atoms)
     lows = (0, 1, 2) if not abstract and _origin_left_out(atoms, len(states)) else (1, 2, 0)
     for power, low, pairs, raised in _variants(powers, bounds,
@@ -234,7 +238,7 @@ class _RefutationProgram(Program):
             if not strict and room >= low:
                 basis = P.monomials(n, low, room)
                 self.multipliers.append(("square", basis,
-                                         self.gram(basis, lambda p, h=h: P.multiply(p, h))))
+                                         self.gram(basis, times=h)))
             elif strict or P.low_degree(h) >= 2 * low:  # s0 keeps no term below 2 low
                 c = self.scalar()
                 self.add_term(c, h)
@@ -249,7 +253,7 @@ class _RefutationProgram(Program):
             if room >= low:
                 basis = P.monomials(n, low, room)
                 self.products.append((i, k, basis,
-                                      self.gram(basis, lambda p, h=h: P.multiply(p, h)), h))
+                                      self.gram(basis, times=h), h))
         strict = [m[1] for m, (_, s) in zip(self.multipliers, atoms) if s]
         self.constant_term = None
         if low == 0:  # the comparison 1 > 0 (s0 and the multipliers have constant terms)
