@@ -12,9 +12,9 @@ from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.kernel.obligations import Obligation
-from fossil_dsl.kernel.prove import discharge
+from fossil_dsl.kernel.prove import SUM_OF_SQUARES, discharge
 from fossil_dsl.outputs.recheck import recheck
-from fossil_dsl.solvers import ball_split
+from fossil_dsl.solvers import arb_box, ball_split
 from fossil_dsl.solvers.atom_facts import abstracted
 from fossil_dsl.solvers.sos_refutation import refute
 
@@ -83,7 +83,18 @@ def test_a_query_that_holds_beyond_the_ball_is_not_proved():
     assert refute(query, STATES, float("inf")) is None
 
 
-def test_the_swing_system_is_certified_by_a_split_and_rechecked(tmp_path):
+def test_the_swing_system_s_decrease_is_refuted_whole_on_its_sublevel_set():
+    # since session 58 the sublevel set V <= beta narrows the ranges of the sines
+    # (arb_box.quadratic_bounds): no split is needed
+    result = fossil_dsl.synthesise(fossil_dsl.load(SWING), seed=0, timeout=120)
+    assert result.certified, result.reason
+    by_name = {p.obligation.name: p.procedure for p in result.kernel.proofs}
+    assert by_name["condition:decrease"] == SUM_OF_SQUARES
+
+
+def test_the_swing_system_is_certified_by_a_split_and_rechecked(tmp_path, monkeypatch):
+    # the ranges from the box alone (as before session 58): only a split proves it
+    monkeypatch.setattr(arb_box, "quadratic_bounds", lambda polynomial, names: [])
     result = fossil_dsl.synthesise(fossil_dsl.load(SWING), seed=0, timeout=120)
     assert result.certified, result.reason
     by_name = {p.obligation.name: p.procedure for p in result.kernel.proofs}
