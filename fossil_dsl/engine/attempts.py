@@ -19,6 +19,7 @@ from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, only_functio
                                        verify_given)
 from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, as_listener
+from fossil_dsl.ir import traversal
 from fossil_dsl.kernel import Claim
 from fossil_dsl.kernel.rules import lemma_radius
 from fossil_dsl.plan.compile import Plan, origin_radius, with_conditions
@@ -186,7 +187,7 @@ def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
     note = "no quadratic V of the linearisation decreases where it holds I"
     for index, finding in enumerate(itertools.islice(quadratic_roa.candidates(plan, budget),
                                                      QUADRATIC_TRIES)):
-        larger = index == 0 and plan.verifier != "z3"  # z3: a polynomial field
+        larger = index == 0 and not all(map(traversal.is_arithmetic, plan.spec.dynamics))
         found, note = _region_proved(plan, backend, listener, deadline, finding,
                                      *(QUADRATIC_REFUTING if larger else
                                        (REACH_REFUTING_SECONDS, ATOMS_MAX_VARIABLES)))

@@ -58,9 +58,7 @@ def _bounds(atom: L.Formula, names):
     polynomial = _at_most_zero(atom, names)
     if polynomial is None:
         return []
-    if _ellipsoid_parts(polynomial, names) is not None:
-        return _ellipsoid_bounds(polynomial, names)
-    return quadratic_bounds(polynomial, names)
+    return _ellipsoid_bounds(polynomial, names) or quadratic_bounds(polynomial, names)
 
 
 def _at_most_zero(atom: L.Formula, names) -> dict | None:
