@@ -285,3 +285,24 @@ def test_monomials_whose_square_nothing_cancels_leave_s0s_basis():
                                                                            (2, 0)]
     assert sos_refutation.cancellable(basis, {(0, 0), (4, 0), (0, 4)}) == [
         (0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]
+
+
+def test_a_strict_comparison_gets_a_polynomial_multiplier_in_the_closure_program():
+    """x > 1 and -x^3 >= 0: with a constant multiplier for x - 1 every identity is odd
+    of degree 3 (no refutation); read as x - 1 >= 0 it takes (2 + x^2)(x - 1) - x^3 +
+    (x - 1)^2 + 1 = 0, a proof that even the closure is empty. Checked exactly; without
+    the closure's program nothing is found."""
+    import time
+    query = L.conjunction(L.Compare(">", X, E.Num(F(1))),
+                          L.Compare(">=", E.neg(E.power(X, E.Num(F(3)))), E.ZERO))
+    found = sos_refutation.refute(query, ("x",), time.monotonic() + 20)
+    assert found is not None and refutation_problem(found, query, ("x",)) is None
+    assert found.constant > 0
+
+
+def test_without_the_closure_program_the_cubic_query_is_not_refuted(monkeypatch):
+    import time
+    monkeypatch.setattr(sos_refutation, "_closure_worthwhile", lambda atoms: False)
+    query = L.conjunction(L.Compare(">", X, E.Num(F(1))),
+                          L.Compare(">=", E.neg(E.power(X, E.Num(F(3)))), E.ZERO))
+    assert sos_refutation.refute(query, ("x",), time.monotonic() + 20) is None

@@ -15,6 +15,7 @@ from fossil_dsl.engine import sos_reach
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.symbolic import to_sympy
 from fossil_dsl.plan.compile import compile_spec
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -230,6 +231,37 @@ def test_a_map_with_reach_avoid_remain_is_left_to_learning():
     assert not sos_reach.applies(compile_spec(fossil_dsl.loads(text, "map.fsl")))
 
 
+def test_a_map_reach_and_stay_is_certified_by_the_program():
+    """For a map's RSWA the program also asks V(f(x)) < β on the inner ball round the
+    origin: with the decrease outside it, a step from F ∩ {V <= β} keeps V <= β (the
+    kernel's last condition); the step staying in F is left to the proof."""
+    text = MAP_RWA.replace("set unsafe", "set final = ball([0, 0], 0.3)\nset unsafe").replace(
+        "not unsafe until goal", "not unsafe until always final").replace(
+        "set goal   = ball([0, 0], 0.2)\n", "")
+    spec = fossil_dsl.loads(text, "map.fsl")
+    plan = compile_spec(spec)
+    assert sos_reach.applies(plan)
+    finding = sos_reach.search(plan, time.monotonic() + 30)
+    assert finding is not None and "beta" in finding.levels
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+    V, beta = result.sympy["V"], float(result.levels["beta"])
+    x0, x1 = sorted(V.free_symbols, key=str)
+    step = V.subs({x0: 0.6 * x0 + 0.2 * x1 ** 2, x1: 0.6 * x1 - 0.2 * x0 * x1},
+                  simultaneous=True)
+    assert float(step.subs({x0: 0, x1: 0})) < beta
+
+
+def test_the_program_finds_nothing_for_a_false_reach_and_stay_property_of_a_map():
+    """f49: a tanh map's orbits from I overshoot into U before settling in F."""
+    spec = fossil_dsl.load(ROOT / "specs" / "false" / "f49_tanh_map_rswa_overshoot.fsl")
+    plan = compile_spec(spec)
+    assert sos_reach.applies(plan)
+    assert sos_reach.search(plan, time.monotonic() + 30) is None
+    assert not fossil_dsl.synthesise(spec, seed=0, timeout=20, max_iters=3).certified
+
+
 @pytest.mark.parametrize("name", ["f32_map_reach_stalls", "f33_map_rwa_through_unsafe"])
 def test_the_program_finds_nothing_for_a_false_reach_property_of_a_map(name):
     """A fixed point in I (f32) and a step from I into the unsafe strip (f33): no V
@@ -316,3 +348,22 @@ def test_a_map_with_sin_is_solved_for_a_polynomial_stand_in():
     assert "polynomial stand-in of degree 3" in result.strategy, result.strategy
     V = result.sympy["V"]
     assert sympy.Poly(V, *sorted(V.free_symbols, key=str)).total_degree() == 2
+
+
+def test_a_barrier_without_a_v_is_kept_and_v_learned_beside_it():
+    """probe59/ac08: the damping 1 + 0.5 (1 - exp(-x)) turns negative for x < -0.8, so no
+    V decreases on all of D outside G (V's program is infeasible), but the barrier
+    program finds B for the stand-in. B alone is returned, and the loop learns V with B
+    fixed (learning both failed in 120 s)."""
+    spec = fossil_dsl.load(ROOT / "specs" / "probe59" / "ac08_exp_focus_rar.fsl")
+    finding = sos_reach.search(compile_spec(spec), time.monotonic() + 30)
+    assert finding is not None and finding.degree == 0 and set(finding.formulas) == {"B"}
+    assert "B of degree" in finding.describe()
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("learning V for sum-of-squares"), result.strategy
+    # the program's B (up to the solver's last digits: Clarabel's threads), not a network
+    symbols = {s.name: s for s in result.sympy["B"].free_symbols}
+    difference = sympy.Poly(result.sympy["B"] - to_sympy(finding.formulas["B"], symbols),
+                            *symbols.values())
+    assert max(abs(float(c)) for c in difference.coeffs()) < 1e-3

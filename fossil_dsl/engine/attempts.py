@@ -42,6 +42,9 @@ REACH_REFUTING_SECONDS = 5.0
 # time for its refutations (probe44/y12's decrease, 8 variables with sin and cos: 1035
 # Gram entries in s0 alone, refuted in 10 s; by bisection not in 60 s)
 QUADRATIC_REFUTING = (20.0, 3_000)  # (seconds, largest program)
+# of the time left, for learning V beside a B found by RAR's barrier program (probe59/ac08:
+# learning both failed in 120 s, V beside the program's B was certified in 50 s)
+LEARNED_BESIDE_SHARE = 0.6
 REPELLING_TRIES = 2  # barriers round a repelling equilibrium proved, at most
 QUADRATIC_TRIES = 2  # quadratic V of the linearisation proved, at most
 CONSERVED_REFINEMENTS = 3  # conserved-quantity barriers chosen again with counterexamples
@@ -267,6 +270,8 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
                                sos_reach.search)
     if finding is None:
         return None, "no sum-of-squares reach certificate found"
+    if not finding.degree:  # RAR's B alone
+        return _learned_beside(plan, backend, listener, deadline, finding)
     # for a stand-in's V the conditions with elementary functions are proved by the
     # solvers (probe55/p07: interval), and where the stand-in misled the program the
     # solvers' pass finds that in a fraction of a second (probe48/c03: 5 s of refuting
@@ -275,6 +280,18 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
         max(REACH_REFUTING_SECONDS, 2 * finding.seconds)
     return prove_found(plan, backend, listener, deadline, finding, refuting,
                        formulas=finding.formulas, prepare=lambda cegis: _set_up(cegis, finding))
+
+
+def _learned_beside(plan: Plan, backend: Backend, listener, deadline: float, finding):
+    """((plan with B given, certified outcome) or None, what happened): the loop learns V
+    with the program's B fixed, for a share of the time left (then both are learned)."""
+    given = replace(plan, functions=tuple(replace(f, candidate=finding.formulas.get(f.name))
+                                          for f in plan.functions))
+    until = time.monotonic() + LEARNED_BESIDE_SHARE * (deadline - time.monotonic())
+    outcome = Cegis(given, backend, listener, until + _learning_imported(given)).run()
+    if outcome.certified:
+        return (given, replace(outcome, strategy=f"learning V for {finding.describe()}")), ""
+    return None, f"{finding.describe()}: no V learned for it: {outcome.reason}"
 
 
 def _conserved(plan: Plan, backend: Backend, listener, deadline: float):

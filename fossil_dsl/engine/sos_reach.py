@@ -2,9 +2,10 @@
 polynomial ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where
 the decrease is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py;
 of any other ODE through a polynomial stand-in for its field: surrogate.py), and for
-reach and RWA of a polynomial map (the decrease is V(f(x)) - V(x), still linear in V's
-coefficients; the kernel's further condition that a step from S outside G with V <= 0
-lands in S is left to the proof); where the system has inputs, with a linear controller
+reach, RWA and RSWA of a map (polynomial, or through a stand-in; the decrease is
+V(f(x)) - V(x), still linear in V's coefficients; the kernel's further conditions that a
+step from S outside G with V <= 0 lands in S, and for RSWA from F with V <= β in F, are
+left to the proof); where the system has inputs, with a linear controller
 fixed beforehand to an LQR gain of its linearisation, rounded as the verifier will see it.
 
 V (a polynomial of degree 2 or 4, coefficients in [-100, 100]) and the largest e with
@@ -20,7 +21,7 @@ condition but keeps the program linear in V; V's sublevel set {V <= 0} may lie a
 so it need not be centred at the origin (an I on one side of G, an unsafe set on the
 other: no ellipsoid round the origin fits between them). For RAR, B (degree 2, then 4)
 comes from the barrier program (sos_barrier.py) with G for I and the part of D outside F
-for U.
+for U; where V's program fails, B alone is returned, and V is learned beside it.
 
 Nothing here is trusted: the functions are rounded and proved like any candidate.
 """
@@ -51,12 +52,11 @@ from fossil_dsl.solvers.gram_rounding import decimal
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 
 FORMS = ("reach while avoid", "reach", "reach-avoid-remain", "reach and stay while avoid")
-DISCRETE_FORMS = ("reach while avoid", "reach")
+DISCRETE_FORMS = ("reach while avoid", "reach", "reach and stay while avoid")
 HALF_DEGREES = (1, 2)  # V of degree 2, then 4
 STAND_IN_DEGREES, MAP_STAND_IN_DEGREES = (3, 5, 7), (3, 5)
 # LQR gains tried with a stand-in, at most: where it works the first or second gain did
-# (19 specs with inputs), and probe36/r01's eight programs without a V took 8.5 s
-STAND_IN_CONTROLLERS = 3
+STAND_IN_CONTROLLERS = 3  # (19 specs with inputs; probe36/r01's eight programs took 8.5 s)
 DECIMALS = 6  # kept of V's coefficients
 MIN_MARGIN = 1e-6
 # |coefficient| of V at most this: γ is absolute, so V must be free to be steep (a
@@ -73,7 +73,7 @@ class ReachFinding:
     controller: dict
     gain: np.ndarray | None  # -K, u = -K x + operating point
     operating: np.ndarray
-    degree: int
+    degree: int  # V's (0: no V, RAR's B alone)
     margin: float
     seconds: float
     levels: dict  # name -> Fraction (RSWA's β), fixed for the proof
@@ -81,6 +81,9 @@ class ReachFinding:
     stand_in: int = 0  # the degree of the field's polynomial stand-in (0: none)
 
     def describe(self) -> str:
+        if not self.degree:
+            return (f"sum-of-squares programming (Clarabel): B of degree "
+                    f"{self.barrier_degree}{self._stand_in()}, {self.seconds:.2f} s")
         control = " for an LQR gain of the linearisation" if self.controller else ""
         if not self.barrier_degree:
             barrier = ""
@@ -88,11 +91,13 @@ class ReachFinding:
             barrier = " and a quadratic B"
         else:
             barrier = f" and B of degree {self.barrier_degree}"
-        stand_in = (f" (solved for a polynomial stand-in of degree {self.stand_in} for "
-                    "the field)") if self.stand_in else ""
         return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}"
-                f"{barrier}{control}{stand_in}, margin {self.margin:.3g}, "
+                f"{barrier}{control}{self._stand_in()}, margin {self.margin:.3g}, "
                 f"{self.seconds:.2f} s")
+
+    def _stand_in(self) -> str:
+        return (f" (solved for a polynomial stand-in of degree {self.stand_in} for the "
+                "field)") if self.stand_in else ""
 
 
 def applies(plan: Plan) -> bool:
@@ -129,7 +134,8 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
             field, denominator, stand_in = found
         if time.monotonic() > deadline or stand_in and index >= STAND_IN_CONTROLLERS:
             break
-        found = _functions(len(states), field, denominator, pieces, deadline, discrete)
+        found = _functions(len(states), field, denominator, pieces, deadline, discrete,
+                           partial=not controller)
         if found is not None:
             formulas, levels, degree, margin = found
             return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
@@ -220,7 +226,8 @@ class _StayPieces:
     """For RSWA, balls round the origin (the closed loop's equilibrium) inside F, of a
     quarter and a half of the sampled distance to F's boundary: V < β on the inner
     one, V > β on F outside the outer one, and V decreases on D outside the inner one.
-    With β fixed, F ∩ {V >= β} then lies where V decreases and ∂F has V > β."""
+    With β fixed, F ∩ {V >= β} then lies where V decreases and ∂F has V > β. For a map,
+    V(f(x)) < β on the inner ball too: a step from F ∩ {V <= β} then keeps V <= β."""
 
     def __init__(self, pieces: _Pieces, final, plan: Plan):
         states = plan.states
@@ -258,9 +265,11 @@ def _distance_to_boundary(region, plan: Plan) -> float | None:
 
 
 def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
-               discrete: bool):
-    """({"V": V, "B": B for RAR}, V's degree, margin) or None; the field is
-    field / denominator (denominator > 0 on D), or the map (`discrete`)."""
+               discrete: bool, partial: bool = False):
+    """({"V": V, "B": B for RAR}, levels, V's degree, margin) or None; the field is
+    field / denominator (denominator > 0 on D), or the map (`discrete`). Where
+    `partial`, RAR's B alone when no V is found (degree 0): V's program asks for a
+    decrease on all of D outside G, which a basin smaller than D rules out."""
     b = None
     if pieces.outside_final is not None:
         b = _barrier(n, field, pieces, deadline)
@@ -278,7 +287,7 @@ def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
             if b is not None:
                 found["B"] = b
             return found, program.levels(x), 2 * half, float(x[program.margin])
-    return None
+    return ({"B": b}, {}, 0, 0.0) if partial and b is not None else None
 
 
 def _barrier(n: int, field, pieces: _Pieces, deadline: float):
@@ -323,6 +332,10 @@ class _ReachProgram(Program):
             for piece in stay.above:
                 self.require(above, piece)
             self.require(negated + [(self.beta, one)], stay.inner)
+            if discrete:  # and V(f(x)) < β there: a step from the inner ball stays below β
+                image = [(v, P.scale(P.compose(t, field), -1))
+                         for v, t in zip(self.coefficients, terms)]
+                self.require(image + [(self.beta, one)], stay.inner)
 
     def levels(self, x) -> dict:
         """β (RSWA) as a short decimal, else nothing."""

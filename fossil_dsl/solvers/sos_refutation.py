@@ -116,13 +116,14 @@ def _refuted_conjunction(query: L.Formula, states, deadline: float,
     powers, limit = ((1,), atoms_limit) if abstract else (POWERS, MAX_VARIABLES)
     bounds = None if abstract else opposite_bounds(atoms)
     lows = (0, 1, 2) if not abstract and _origin_left_out(atoms, len(states)) else (1, 2, 0)
-    for power, low, pairs, raised in _variants(powers, bounds,
-                                               _raise_worthwhile(abstract, states, atoms),
-                                               lows):
+    for power, low, pairs, raised, closed in _variants(
+            powers, bounds, _raise_worthwhile(abstract, states, atoms), lows,
+            _closure_worthwhile(atoms)):
         if time.monotonic() > deadline or _smallest_size(len(states), atoms, power) > limit:
             return None
         try:
-            program = _RefutationProgram(len(states), atoms, low, power, pairs, raised)
+            program = _RefutationProgram(len(states), atoms, low, power, pairs, raised,
+                                         closed)
         except _Hopeless:
             continue
         if program.count > limit:
@@ -156,24 +157,40 @@ def _origin_left_out(atoms, n: int) -> bool:
     return any(h.get(zero, 0) < 0 for h, _ in atoms)
 
 
-def _variants(powers, pairs, raise_too: bool, lows=(1, 2, 0)):
-    """(power, low, products, raised) of the programs tried, in order: each program with
+def _closure_worthwhile(atoms) -> bool:
+    """Whether a strict comparison would get a multiplier that is not a constant if it
+    were read as h >= 0 (its degree is at least 2 below the query's)."""
+    top = max(2, max(P.degree(h) for h, _ in atoms))
+    return any(strict and 2 * ((top + 1) // 2) - P.degree(h) >= 2 for h, strict in atoms)
+
+
+def _variants(powers, pairs, raise_too: bool, lows=(1, 2, 0), closure: bool = False):
+    """(power, low, products, raised, closed) of the programs tried, in order: each program with
     each low of `lows` in turn (1, 2, 0; 0 first where the origin is left out) and the
     first power again with the box's products, if there are any (not in every variant: a
     3-state map's unrefutable query took 8.4 s instead of 3.3 s), and none for abstracted
     queries, whose facts' bounds would make their programs larger.
     Last, where they are small, the programs with low 0 with multipliers of one degree
     more (`raised`): a decrease on a sublevel set {V <= β} of a degree-6 V (probe48/c02,
-    tight against the basin) needs a multiplier of β - V of degree 4, not 2."""
+    tight against the basin) needs a multiplier of β - V of degree 4, not 2.
+    After the first power's programs, where it differs (`closure`), the program for the
+    query's closure (`closed`):
+    every comparison read as h >= 0, with sums of squares as multipliers, and the constant
+    1 > 0: a proof that even the closure is empty. A strict comparison such as "outside
+    the goal ball", |x|^2 - r^2 > 0, otherwise has a constant multiplier only, where the
+    decrease it guards may need a polynomial one (probe59/ac15: a map's quartic V, found
+    with a margin of 0.28 on D outside G, had no other refutation of its decrease)."""
     found = []
     for power, low in ((m, low) for m in powers for low in lows):
-        found.append((power, low, (), 0))
+        found.append((power, low, (), 0, False))
         if pairs and power == powers[0] and low != 2:
-            found.append((power, low, pairs, 0))
-    if not raise_too:
-        return found
-    return found + [(powers[0], 0, products, 1) for products in ((pairs,) if pairs else ())
-                    + ((),)]
+            found.append((power, low, pairs, 0, False))
+        if closure and power == powers[0] and low == lows[-1]:
+            found.append((power, 0, pairs or (), 0, True))
+    if raise_too:
+        found += [(powers[0], 0, products, 1, False)
+                  for products in ((pairs,) if pairs else ()) + ((),)]
+    return found
 
 
 def opposite_bounds(atoms) -> list[tuple[int, int]] | None:
@@ -226,8 +243,10 @@ class _RefutationProgram(Program):
     so that s0's Gram matrix survives rounding."""
 
     def __init__(self, n: int, atoms: list[tuple[P.Polynomial, bool]], low: int, power: int,
-                 pairs: list[tuple[int, int]] = (), raised: int = 0):
+                 pairs: list[tuple[int, int]] = (), raised: int = 0, closed: bool = False):
         super().__init__(n)
+        if closed:  # h > 0 read as h >= 0: sound, h > 0 implies it
+            atoms = [(h, False) for h, _ in atoms]
         self.atoms = [(P.power(h, power, n) if strict else h, strict) for h, strict in atoms]
         self.power = power
         top = max(2, max(P.degree(h) for h, _ in self.atoms))
