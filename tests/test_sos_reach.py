@@ -367,3 +367,13 @@ def test_a_barrier_without_a_v_is_kept_and_v_learned_beside_it():
     difference = sympy.Poly(result.sympy["B"] - to_sympy(finding.formulas["B"], symbols),
                             *symbols.values())
     assert max(abs(float(c)) for c in difference.coeffs()) < 1e-3
+
+
+def test_a_stand_in_finding_gets_longer_solver_queries():
+    """probe60/ad08, a tanh ring's RAR: the program's quartic V, solved for a stand-in,
+    needs about 6 s of the interval procedure for its decrease; at 5 s a query it was
+    passed to learning, which failed in 100 s."""
+    spec = fossil_dsl.load(ROOT / "specs/probe60/ad08_tanh_ring_rar_3d.fsl")
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert "polynomial stand-in of degree" in result.strategy, result.strategy

@@ -15,8 +15,8 @@ from dataclasses import replace
 from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos, sos_reach,
                                sos_roa, torch_import)
 from fossil_dsl.engine.given import verifier_only
-from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, only_function, prove_found,
-                                       verify_given)
+from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, STAND_IN_QUERY_SECONDS, NotSetUp,
+                                       only_function, prove_found, verify_given)
 from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, as_listener
 from fossil_dsl.ir import traversal
@@ -278,8 +278,9 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
     # to no end before)
     refuting = 2 * finding.seconds if finding.stand_in else \
         max(REACH_REFUTING_SECONDS, 2 * finding.seconds)
-    return prove_found(plan, backend, listener, deadline, finding, refuting,
-                       formulas=finding.formulas, prepare=lambda cegis: _set_up(cegis, finding))
+    querying = STAND_IN_QUERY_SECONDS if finding.stand_in else SOS_QUERY_SECONDS
+    return prove_found(plan, backend, listener, deadline, finding, refuting, querying,
+                       finding.formulas, prepare=lambda cegis: _set_up(cegis, finding))
 
 
 def _learned_beside(plan: Plan, backend: Backend, listener, deadline: float, finding):

@@ -17,6 +17,11 @@ from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, refute
 # candidate the solvers cannot prove at once is left to learning (bb25: an interval
 # proof of 50 s against 6 s of learning)
 SOS_QUERY_SECONDS = 5.0
+# the same for a reach program's functions solved for a polynomial stand-in of the field:
+# its conditions with elementary functions can only be proved by the solvers, and
+# learning is the weaker alternative there (probe60/ad08, a tanh ring's RAR: the quartic
+# V's decrease took the interval procedure 6 s; at 5 s, learning then failed in 100 s)
+STAND_IN_QUERY_SECONDS = 15.0
 
 
 class NotSetUp(Exception):

@@ -165,21 +165,22 @@ def _closure_worthwhile(atoms) -> bool:
 
 
 def _variants(powers, pairs, raise_too: bool, lows=(1, 2, 0), closure: bool = False):
-    """(power, low, products, raised, closed) of the programs tried, in order: each program with
-    each low of `lows` in turn (1, 2, 0; 0 first where the origin is left out) and the
-    first power again with the box's products, if there are any (not in every variant: a
-    3-state map's unrefutable query took 8.4 s instead of 3.3 s), and none for abstracted
-    queries, whose facts' bounds would make their programs larger.
+    """(power, low, products, raised, closed) of the programs tried, in order.
+
+    Each power with each low of `lows` in turn (1, 2, 0; 0 first where the origin is left
+    out), and the first power again with the box's products, if there are any (not in
+    every variant: a 3-state map's unrefutable query took 8.4 s instead of 3.3 s), and
+    none for abstracted queries, whose facts' bounds would make their programs larger.
+    After the first power's programs, where it differs (`closure`), the program for the
+    query's closure (`closed`): every comparison read as h >= 0, with sums of squares as
+    multipliers, and the constant 1 > 0, a proof that even the closure is empty. A strict
+    comparison such as "outside the goal ball", |x|^2 - r^2 > 0, otherwise has a constant
+    multiplier only, where the decrease it guards may need a polynomial one (probe59/ac15:
+    a map's quartic V, found with a margin of 0.28 on D outside G, had no other
+    refutation of its decrease).
     Last, where they are small, the programs with low 0 with multipliers of one degree
     more (`raised`): a decrease on a sublevel set {V <= β} of a degree-6 V (probe48/c02,
-    tight against the basin) needs a multiplier of β - V of degree 4, not 2.
-    After the first power's programs, where it differs (`closure`), the program for the
-    query's closure (`closed`):
-    every comparison read as h >= 0, with sums of squares as multipliers, and the constant
-    1 > 0: a proof that even the closure is empty. A strict comparison such as "outside
-    the goal ball", |x|^2 - r^2 > 0, otherwise has a constant multiplier only, where the
-    decrease it guards may need a polynomial one (probe59/ac15: a map's quartic V, found
-    with a margin of 0.28 on D outside G, had no other refutation of its decrease)."""
+    tight against the basin) needs a multiplier of β - V of degree 4, not 2."""
     found = []
     for power, low in ((m, low) for m in powers for low in lows):
         found.append((power, low, (), 0, False))
