@@ -38,3 +38,23 @@ def test_the_terms_are_the_shifted_constraint_twice_off_the_diagonal():
     # x*x * 3x, 2 * x*y * 3x, y*y * 3x, each negated
     assert program.identity == {(0, (3, 0)): {0: -3.0}, (0, (2, 1)): {1: -6.0},
                                 (0, (1, 2)): {2: -3.0}}
+
+
+def _blocks(sizes: dict[int, int]) -> Program:
+    """A program with `count` Gram blocks of each size (nothing else: only its cost)."""
+    program = Program(3)
+    for size, count in sizes.items():
+        basis = P.monomials(3, 0, 8)[:size]
+        for _ in range(count):
+            program.gram(basis, lambda p: {})
+    return program
+
+
+def test_a_program_whose_iterations_cannot_fit_in_its_time_is_not_tried():
+    # probe60/ae06's quartic reach program: its first iteration alone took 95 s
+    reach = _blocks({84: 2, 56: 11, 10: 10, 4: 77})
+    assert reach.too_costly(27.0)
+    assert reach.solve({0: 1.0}, 27.0) is None  # at once, without Clarabel
+    # probe56/u02's quartic region of attraction: 1.1 s an iteration
+    region = _blocks({56: 1, 21: 27, 6: 166})
+    assert not region.too_costly(30.0) and region.too_costly(1.0)

@@ -4,6 +4,7 @@ integrators: the closed loop keeps no such ellipsoid), a V of the program is pro
 the kernel; an unstable system gets none."""
 import functools
 import time
+from pathlib import Path
 
 import pytest
 
@@ -98,3 +99,15 @@ def test_the_attempt_is_left_out_for_user_templates_and_the_largest_region():
     largest = CHAIN.replace("prove from init: stable",
                             "prove from init: stable\nsynthesis {\n    region: largest\n}")
     assert not sos_roa.applies(compile_spec(fossil_dsl.loads(largest)))
+
+
+def test_a_program_the_first_factorisation_stalls_on_is_solved_by_the_second():
+    """probe60/ae03, four Lotka-Volterra species: no quadratic V holds the box I inside
+    the box D; the quartic program stops with insufficient progress in Clarabel's default
+    factorisation and is solved by qdldl."""
+    path = Path(__file__).resolve().parent.parent / "specs/probe60"
+    spec = fossil_dsl.load(path / "ae03_volterra_four_species_roa_4d.fsl")
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+    assert "V of degree 4" in result.strategy, result.strategy

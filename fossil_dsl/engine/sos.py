@@ -175,7 +175,7 @@ def faces(domain: list[P.Polynomial]) -> list[list[P.Polynomial]]:
 class _LyapunovProgram(Program):
     def __init__(self, n: int, field: list[P.Polynomial], constraints: list[P.Polynomial],
                  degree: int, power: int, discrete: bool):
-        super().__init__(n)
+        super().__init__(n, searches=True)
         self.discrete = discrete
         change = lambda p: P.change(p, field, discrete)  # dV/dt or V(f(x)) - V(x)
         self.z = P.monomials(n, 1, degree)

@@ -79,7 +79,7 @@ class BarrierProgram(Program):
 
     def __init__(self, n: int, field, initial, unsafe_pieces, domain, degree: int,
                  mu: float, denominator: P.Polynomial | None = None):
-        super().__init__(n)
+        super().__init__(n, searches=True)
         self.basis = P.monomials(n, 0, 2 * degree)
         self.coefficients = self.unknown_polynomial(self.basis, 1.0)  # -1 <= b <= 1
         self.margin = self.scalar()

@@ -307,7 +307,7 @@ def _barrier(n: int, field, pieces: _Pieces, deadline: float):
 class _ReachProgram(Program):
     def __init__(self, n: int, field, denominator, pieces: _Pieces, half: int,
                  discrete: bool):
-        super().__init__(n)
+        super().__init__(n, searches=True)
         self.basis = P.monomials(n, 0, 2 * half)
         self.coefficients = self.unknown_polynomial(self.basis, BOUND)
         self.margin = self.scalar()

@@ -94,7 +94,7 @@ def _sets(plan: Plan):
 
 class _RegionProgram(Program):
     def __init__(self, n: int, field, domain, initial, half: int, discrete: bool):
-        super().__init__(n)
+        super().__init__(n, searches=True)
         self.basis = P.monomials(n, 2, 2 * half)
         self.coefficients = self.unknown_polynomial(self.basis, BOUND)
         self.margin = self.scalar()

@@ -18,12 +18,16 @@ import numpy as np
 from fossil_dsl.ir import polynomials as P
 
 
-# The sum over Gram blocks of (entries of the block's upper triangle)^3 that Clarabel
-# gets through in a second, about: the dense block Hessians dominate its iterations. On a
-# machine about 5 times slower than usual, a 5-state program with one 125-monomial block
-# and ten of 55 (5e11) took 118 s against a time limit of 20 s; the rate is set for a
-# usual machine (programs up to 4 times over the limit there are not tried)
-CUBED_ENTRIES_PER_SECOND = 1e10
+# The sum over Gram blocks of (entries of the block's upper triangle)^3 that one of
+# Clarabel's iterations gets through in a second, about: the dense block Hessians
+# dominate. Measured on this machine (two runs beside): 1.4e9 (a 4-state quartic region
+# of attraction, 0.19 s an iteration; a 3-state map's quartic reach program, 95 s for
+# its first iteration) to 4.1e9 (a 5-state one, 1.1 s an iteration). Clarabel heeds its
+# time limit only between iterations, and a solve takes 20 to 40 of them: a program is
+# tried only where FEWEST_ITERATIONS of them fit in its time (the reach program above
+# had been given 27 s and took 100 s).
+CUBED_ENTRIES_PER_SECOND = 3e9
+FEWEST_ITERATIONS = 10
 # Clarabel's factorisations in turn: its default (faer here: multithreaded, the fastest
 # by far on large programs, a 5-state quartic region of attraction in 37 s against
 # qdldl's 214), then, where that stops with a numerical error, qdldl (the 3-state
@@ -39,8 +43,9 @@ class Program:
     the current one, `new_identity` starts the next), linear equalities and
     inequalities, a linear objective; solved by Clarabel."""
 
-    def __init__(self, n: int):
+    def __init__(self, n: int, searches: bool = False):
         self.n = n
+        self.searches = searches  # for a certificate (see _retried_after)
         self.count = 0  # variables
         self.blocks: list[tuple[int, list[P.Monomial]]] = []  # (first variable, basis)
         self.tag = 0  # which identity terms are added to
@@ -130,8 +135,8 @@ class Program:
     def too_costly(self, seconds: float) -> bool:
         """Whether the program would take much longer than `seconds` (Clarabel heeds its
         time limit only between iterations, and its setup not at all)."""
-        return sum(math.comb(len(basis) + 1, 2) ** 3 for _, basis in self.blocks) \
-            > seconds * CUBED_ENTRIES_PER_SECOND
+        cubed = sum(math.comb(len(basis) + 1, 2) ** 3 for _, basis in self.blocks)
+        return FEWEST_ITERATIONS * cubed > seconds * CUBED_ENTRIES_PER_SECOND
 
     def solve(self, objective: dict[int, float], seconds: float):
         """The solution, or None: infeasible, unsolved in time, or too costly to try."""
@@ -174,13 +179,26 @@ class Program:
             started = time.monotonic()
             solution = clarabel.DefaultSolver(sparse.csc_matrix((self.count, self.count)), q,
                                               A, np.array(right), cones, settings).solve()
-            if str(solution.status) != "NumericalError":
+            status = str(solution.status)
+            if status not in self._retried_after():
                 break
             spent = time.monotonic() - started
-            limit = min(seconds - spent, RETRY_SHARE * spent)
+            # a stall is no sign of a hard program (ae03: faer stalled in 4 s, qdldl needs
+            # 9 s, 14 s with a run beside it)
+            limit = seconds - spent if status == "InsufficientProgress" else \
+                min(seconds - spent, RETRY_SHARE * spent)
         if str(solution.status) not in ("Solved", "AlmostSolved"):
             return None
         return np.array(solution.x)
+
+    def _retried_after(self) -> tuple[str, ...]:
+        """The first method's statuses after which the next is tried: a program that
+        searches for a certificate (a few per run) is retried where the first stalled too
+        (probe60/ae03, a 4-state quartic region of attraction: faer's insufficient
+        progress, qdldl's solution with margin 0.55); refutations, tried on many queries
+        that have none, are not."""
+        return ("NumericalError", "InsufficientProgress") if self.searches else \
+            ("NumericalError",)
 
     def matrix(self, x, entries, size: int) -> np.ndarray:
         G = np.zeros((size, size))
