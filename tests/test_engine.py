@@ -421,3 +421,22 @@ def test_without_a_goal_the_controller_is_steered_to_the_origin():
     assert learner.control_target.abs().max() == 0
     learner.field = lambda points: list((-points).unbind(1))
     assert float(learner.control_loss()) == pytest.approx(-1.0)
+
+
+STEERED_MAP = STEERED.replace("continuous", "discrete").replace(
+    "x0' = u0", "next(x0) = x0 + 0.1*u0").replace("x1' = u1", "next(x1) = x1 + 0.1*u1")
+
+
+def test_a_map_is_steered_by_its_step_not_by_a_jump_across_the_target():
+    """For a map the control loss looks at the step f(x) - x: a step halfway to the
+    goal's centre scores -1, and a jump far across it no better (probe60/ae06: with the
+    next state itself, a jump across scored best, and the learned gain grew to 6e4)."""
+    from fossil_dsl.engine.learner import Learner
+    plan = compile_spec(spec_text(STEERED_MAP))
+    learner = Learner(plan, torch.Generator().manual_seed(0))
+    centre = learner.control_target
+    learner.field = lambda points: list((points + 0.5 * (centre - points)).unbind(1))
+    halfway = float(learner.control_loss())
+    learner.field = lambda points: list((points + 50 * (centre - points)).unbind(1))
+    assert halfway == pytest.approx(-1.0)
+    assert float(learner.control_loss()) == pytest.approx(halfway)
