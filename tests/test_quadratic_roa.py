@@ -5,7 +5,6 @@ from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
-import pytest
 import sympy
 
 import fossil_dsl
@@ -48,11 +47,6 @@ def test_the_level_is_just_over_the_largest_value_on_i():
     assert found.describe().startswith("the linearisation's quadratic V on its smallest")
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "since session 60's machine, the kernel does not prove n06's decrease in its time: the "
-    "refutation within the excluded ball's neighbourhood (kernel/prove.py, _split_at_ball) "
-    "is rejected after 0.5 s and the interval procedure runs out with 10 of 233 472 boxes "
-    "left; the same with session 59's code (07dba88), whose CI passed this test; open"))
 def test_a_pendulum_on_a_cart_gets_the_ellipsoid_between_i_and_d_and_its_gain():
     """probe53/n06: every LQR Lyapunov ellipsoid is flat, so each sublevel set that
     holds the ball I leaves D; the ellipsoid program's P and gain fit."""

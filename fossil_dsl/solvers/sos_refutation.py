@@ -27,7 +27,7 @@ from fossil_dsl.ir import polynomials as P
 from fossil_dsl.solvers.api import Answer, Status
 from fossil_dsl.solvers.atom_facts import has_atoms, replaceable
 from fossil_dsl.solvers.gram_rounding import (MULTIPLIER_DECIMALS, decimal, projected,
-                                             psd_square)
+                                             psd_square, settled)
 from fossil_dsl.solvers.positivstellensatz import (CaseSplit, Evidence, Power, Product,
                                                   Refutation, cases, comparisons, conjuncts,
                                                   disjunction_branches, polynomial_form,
@@ -291,38 +291,41 @@ class _RefutationProgram(Program):
         self.at_most.append(({self.interior: 1.0}, 1.0))
 
     def exact(self, x) -> Refutation | None:
-        multipliers = []
-        total = {}
+        multipliers, squares, factors, total = [], [], [], {}
         for (h, strict), multiplier in zip(self.atoms, self.multipliers):
-            if multiplier[0] == "none":
-                multipliers.append(None)
-                continue
             if multiplier[0] == "constant":
                 c = max(Fraction(0), decimal(x[multiplier[1]], MULTIPLIER_DECIMALS))
                 multipliers.append(Power(c, self.power) if strict and self.power > 1 else c)
                 total = P.add(total, P.scale(h, c))
-                continue
-            _, basis, entries = multiplier
-            square = psd_square(basis, self.matrix(x, entries, len(basis)))
-            if square is None:
-                return None
-            multipliers.append(square)
-            total = P.add(total, P.multiply(square.polynomial(), h))
-        products = []
-        for i, k, basis, entries, h in self.products:
-            square = psd_square(basis, self.matrix(x, entries, len(basis)))
-            if square is None:
-                return None
-            products.append(Product(i, k, square))
+            elif multiplier[0] == "square":
+                multipliers.append(multiplier)  # replaced by its rounded square below
+                squares.append(psd_square(multiplier[1], self.matrix(x, multiplier[2],
+                                                                     len(multiplier[1]))))
+                factors.append(h)
+            else:
+                multipliers.append(None)
+        squares += [psd_square(basis, self.matrix(x, entries, len(basis)))
+                    for _, _, basis, entries, _ in self.products]
+        factors += [h for *_, h in self.products]
+        if any(square is None for square in squares):
+            return None
+        for square, h in zip(squares, factors):
             total = P.add(total, P.multiply(square.polynomial(), h))
         constant = Fraction(0)
         if self.constant_term is not None:
             constant = max(Fraction(0), decimal(x[self.constant_term], MULTIPLIER_DECIMALS))
             total = P.add(total, P.constant(constant, self.n))
+        reach = {P.times(a, b) for a in self.basis for b in self.basis}
+        if (settled_ := settled(squares, factors, total, reach)) is None:
+            return None
+        squares, total = settled_
         G = self.matrix(x, self.rest, len(self.basis)) + x[self.interior] * np.eye(len(self.basis))
         rest = projected(self.basis, G, P.scale(total, -1))
         if rest is None:
             return None
+        rounded = iter(squares)
+        multipliers = [next(rounded) if isinstance(m, tuple) else m for m in multipliers]
+        products = [Product(i, k, next(rounded)) for i, k, *_ in self.products]
         return Refutation(tuple(multipliers), rest, constant, tuple(products))
 
 
