@@ -392,29 +392,34 @@ prove from init: always not unsafe
 """
 
 
-def test_a_barrier_no_quadratic_can_be_is_found_quartic_where_the_program_is_small(
-        monkeypatch):
+def test_a_box_initial_set_needs_its_products_for_a_quadratic_barrier(monkeypatch):
+    """-B - e >= 0 on the box I with constant multipliers of its linear bounds needs
+    -B's Hessian PSD, which no B convex enough to stay positive on U has; the products
+    (s - l)(u - s) >= 0 bring the -s^2 terms. Without them no quadratic B was found and
+    the program went on to a quartic (sessions up to 60)."""
     with monkeypatch.context() as patch:
         patch.setattr(sos_barrier, "DEGREES", (1,))
+        patch.setattr(sos_barrier, "interval_products", lambda constraints: constraints)
         assert sos_barrier.barrier(_plan(EPIDEMIC), time.monotonic() + 30) is None
     found = sos_barrier.barrier(_plan(EPIDEMIC), time.monotonic() + 30)
-    assert found is not None and found.degree == 4
+    assert found is not None and found.degree == 2
     # (since session 53 a run takes s exp(-2 (s + i)), conserved, before the programs)
     monkeypatch.setattr(first_integral, "applies", lambda plan: False)
     result = fossil_dsl.synthesise(fossil_dsl.loads(EPIDEMIC), timeout=60)
     assert result.certified, result.summary()
-    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 4")
+    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 2")
 
 
-def test_a_quartic_barrier_in_six_states_is_tried_and_proved():
-    """bb25 (6 states): its quartic program (1 877 variables) was once left out, since
-    its B took the solvers longer than learning did; its refutations are now found at
-    once. probe48/c09, a non-normal linear system in 6 states, has no quadratic barrier
-    at all (2 465 variables for the quartic)."""
-    text = (Path(__file__).resolve().parent.parent / "specs/barrierbench/bb25.fsl").read_text()
-    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=60)
-    assert result.certified, result.summary()
-    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 4")
+def test_six_state_barriers_are_quadratic_with_the_initial_sets_products():
+    """bb25 and probe48/c09 (a non-normal linear system) had quartic barriers (programs
+    of 1 877 and 2 465 variables) while I's box entered without its products; with
+    them each has a quadratic one, proved at once."""
+    root = Path(__file__).resolve().parent.parent
+    for path in (root / "specs/barrierbench/bb25.fsl",
+                 root / "specs/probe48/c09_nonnormal_linear_6d_safety.fsl"):
+        result = fossil_dsl.synthesise(fossil_dsl.load(path), timeout=60)
+        assert result.certified and result.kernel.certified, result.summary()
+        assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 2")
 
 
 def test_a_decrease_on_a_tight_sublevel_set_needs_multipliers_of_one_degree_more(monkeypatch):
@@ -445,18 +450,19 @@ def test_a_decrease_on_a_tight_sublevel_set_needs_multipliers_of_one_degree_more
 def test_a_rational_field_gets_a_barrier_multiplied_through_its_denominator():
     """probe53/n03, a chemostat with Monod uptake s/(0.5 + s): learning timed out
     (120 s). Over the denominator 10 + 20 s (positive on D) the flow condition is
-    linear in B again; no B of degree 2 or 4 exists, one of degree 6 does."""
+    linear in B again; no B of degree 2 exists, one of degree 4 does (of degree 6 before
+    I's products entered the programs)."""
     path = Path(__file__).resolve().parent.parent / "specs/probe53/n03_chemostat_washout_safety.fsl"
     plan = compile_spec(fossil_dsl.load(path))
     assert sos.applies(plan) and sos.field_of(plan) is None
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(sos_barrier, "DEGREES", (1, 2))
+        patch.setattr(sos_barrier, "DEGREES", (1,))
         assert sos_barrier.barrier(plan, time.monotonic() + 30) is None
     found = sos_barrier.barrier(plan, time.monotonic() + 30)
-    assert found is not None and found.degree == 6
+    assert found is not None and found.degree == 4
     result = fossil_dsl.synthesise(fossil_dsl.load(path), timeout=90)
     assert result.certified and result.kernel.certified, result.summary()
-    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 6")
+    assert result.strategy.startswith("sum-of-squares programming (Clarabel): B of degree 4")
 
 
 def test_a_rational_field_whose_denominator_changes_sign_on_d_gets_no_barrier():

@@ -23,7 +23,6 @@ from fractions import Fraction
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
-from fossil_dsl.ir import traversal
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
 from fossil_dsl.solvers.sdp import Program
@@ -58,16 +57,15 @@ class SosFinding:
 
 def applies(plan: Plan) -> bool:
     """A polynomial autonomous system, a Lyapunov-type property (or safety in continuous
-    time, where the field may be rational), and no template or candidate chosen by the
-    user."""
+    time, where the field may be rational or have elementary functions: sos_barrier.py),
+    and no template or candidate chosen by the user."""
     spec = plan.spec
     form = plan.certificate.form in FORMS or (
         plan.certificate.form == "safety" and spec.time is TimeDomain.CONTINUOUS)
     return (form and plan.controller is None and not spec.inputs
             and spec.torch_dynamics is None and spec.synthesis.certificate is None
             and spec.synthesis.candidate is None and not plan.options.learn_only
-            and (field_of(plan) is not None or plan.certificate.form == "safety"
-                 and all(traversal.is_arithmetic(f) for f in spec.dynamics)))
+            and (field_of(plan) is not None or plan.certificate.form == "safety"))
 
 
 def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:

@@ -1,5 +1,6 @@
-"""A barrier certificate by sum-of-squares programming, for safety of a polynomial (or
-rational: multiplied through by its denominator, positive on D) ODE.
+"""A barrier certificate by sum-of-squares programming, for safety of a polynomial ODE
+(or rational: multiplied through by its denominator, positive on D; or with elementary
+functions: each application a variable bounded by its facts, atom_facts.py).
 
 Find a polynomial B (coefficients in [-1, 1]) and the largest e with
 
@@ -21,20 +22,20 @@ from fractions import Fraction
 
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.sos import MIN_MARGIN, SosFinding, field_of, rounded, set_constraints
+from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, field_of, interval_products, rounded,
+                                   set_constraints)
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir import traversal
 from fossil_dsl.ir.sets import Intersection
+from fossil_dsl.solvers.atom_facts import abstracted_terms
+from fossil_dsl.solvers.positivstellensatz import comparisons
 from fossil_dsl.plan.compile import Plan
 
-# B of degree 2 first, then 4 where that program is not too large: with 2 states (z03,
-# an SIR model whose quadratic programs are infeasible) the quartic program of 251
-# variables is solved and refuted at once, where learning failed in 25 iterations; a
-# 6-state non-normal linear system (probe48/c09) has no quadratic barrier and a quartic
-# one of 2 465 variables (found in 5 s, refuted in 10 s). (bb25's quartic B, 1 877
-# variables, once had no refutation whose Gram matrix survived rounding; it is now
-# certified by it in 6.5 s.) Degree 6 last: a chemostat's Monod field (probe53/n03,
-# rational) has none of degree 2 or 4 and one of 668 variables found in 0.1 s.
+# B of degree 2 first, then 4 and 6 where the program is not too large (before I's box
+# entered with its products, bb25 and probe48/c09 (6 states) needed quartic barriers,
+# programs of 1 877 and 2 465 variables, and a chemostat (probe53/n03, rational) one of
+# degree 6; with them they have quadratic ones, and the chemostat a quartic one)
 DEGREES = (1, 2, 3)
 HIGHER_DEGREE_MAX_VARIABLES = 3000
 DECAY_RATES = (1.0, 0.1, 10.0)  # mu, in the order tried
@@ -44,43 +45,84 @@ DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 def barrier(plan: Plan, deadline: float) -> SosFinding | None:
     started = time.monotonic()
     states = plan.states
-    field, denominator = field_of(plan), P.constant(1, len(states))
-    if field is None:  # a rational field (sos.applies): dB/dt = grad B . N / Q with Q > 0
-        found = over_one_denominator(plan.spec.dynamics, states,
-                                     plan.spec.domain.bounding_box(), plan.options.seed)
-        if found is None:
-            return None
-        field, denominator = found
-    domain = set_constraints(plan.spec.domain, states)
-    initial = set_constraints(plan.spec.property.role("initial"), states)
-    unsafe = set_constraints(Intersection(plan.spec.property.role("unsafe"), plan.spec.domain),
-                             states)
-    for degree in DEGREES:
+    problem = _polynomial_problem(plan)
+    if problem is None:
+        return None
+    n, field, denominator, facts = problem
+    # I with its box's products: -B - e >= 0 on I with constant multipliers of I's
+    # linear bounds needs -B's Hessian to be PSD, which no quadratic B positive on U
+    # has; the products (x - l)(u - x) >= 0 bring the -x^2 terms (probe61/ag03, a
+    # 6-state chain of masses with tanh friction: a quadratic B, else none). D's products
+    # made the flow condition's programs larger for nothing (probe61/af11: 0.4 -> 2 s)
+    domain = _padded(set_constraints(plan.spec.domain, states), n) + facts
+    initial = _padded(interval_products(
+        set_constraints(plan.spec.property.role("initial"), states)), n)
+    unsafe = _padded(set_constraints(Intersection(plan.spec.property.role("unsafe"),
+                                                  plan.spec.domain), states), n)
+    # with facts, B of degree 6 gave programs of tiny margins whose B failed (a05: 5 s)
+    for degree in DEGREES[:2] if facts else DEGREES:
         for mu in DECAY_RATES:
             if time.monotonic() > deadline:
                 return None
-            program = BarrierProgram(len(states), field, initial, [unsafe], domain, degree, mu,
-                                     denominator)
+            program = BarrierProgram(n, field, initial, [unsafe], domain, degree, mu,
+                                     denominator, len(states))
             if program.count > (MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES):
                 return None
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
             if x is None or x[program.margin] <= MIN_MARGIN:
                 continue
-            formula = P.to_expr(program.exact_b(x), states)
+            b = {m[:len(states)]: c for m, c in program.exact_b(x).items()}
             margin = float(x[program.margin])
-            return SosFinding(formula, "B", 2 * degree, margin,
+            return SosFinding(P.to_expr(b, states), "B", 2 * degree, margin,
                               f"B < 0 on I, B > 0 on U, dB/dt <= -{mu:g} B on D with "
-                              f"margin {margin:.3g}", time.monotonic() - started)
+                              f"margin {margin:.3g}" + (" (the field's functions bounded "
+                                                       "by their facts)" if facts else ""),
+                              time.monotonic() - started)
     return None
+
+
+def _polynomial_problem(plan: Plan):
+    """(variables, field, denominator, facts) of the program: the states and a polynomial
+    field (1 as the denominator); a rational field over one denominator Q > 0 on D; or,
+    for a field with sin, tanh, exp, ..., the states and a variable per application,
+    the field in them, and the facts every application satisfies on D (atom_facts.py;
+    the flow condition then holds for every function obeying them, the true one among
+    them). None where none applies."""
+    states = plan.states
+    field = field_of(plan)
+    if field is not None:
+        return len(states), field, P.constant(1, len(states)), []
+    if all(traversal.is_arithmetic(f) for f in plan.spec.dynamics):
+        found = over_one_denominator(plan.spec.dynamics, states,
+                                     plan.spec.domain.bounding_box(), plan.options.seed)
+        return None if found is None else (len(states), found[0], found[1], [])
+    found = abstracted_terms(plan.spec.dynamics, plan.spec.domain.contains_formula(states),
+                             states)
+    if found is None:
+        return None
+    terms, facts, names = found
+    try:
+        field = [P.polynomial(term, names) for term in terms]
+        constraints = [h for fact in facts for h, _ in comparisons(fact, names)]
+    except ValueError:  # not polynomial after all (a rational argument, say)
+        return None
+    return len(names), field, P.constant(1, len(names)), constraints
+
+
+def _padded(constraints: list[P.Polynomial], n: int) -> list[P.Polynomial]:
+    """The constraints over the first variables as polynomials in n variables."""
+    return [{m + (0,) * (n - len(m)): c for m, c in g.items()} for g in constraints]
 
 
 class BarrierProgram(Program):
     """The identities above; U given as pieces (constraint lists), B > 0 on each."""
 
     def __init__(self, n: int, field, initial, unsafe_pieces, domain, degree: int,
-                 mu: float, denominator: P.Polynomial | None = None):
+                 mu: float, denominator: P.Polynomial | None = None,
+                 states: int | None = None):
         super().__init__(n, searches=True)
-        self.basis = P.monomials(n, 0, 2 * degree)
+        # B is over the first `states` variables (the rest stand for function values)
+        self.basis = [m + (0,) * (n - len(m)) for m in P.monomials(states or n, 0, 2 * degree)]
         self.coefficients = self.unknown_polynomial(self.basis, 1.0)  # -1 <= b <= 1
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))

@@ -179,6 +179,22 @@ def abstracted(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tupl
     return L.conjunction(body, *facts), tuple(states) + tuple(table.names.values())
 
 
+def abstracted_terms(terms: Sequence[E.Expr], region: L.Formula, states: Sequence[str]
+                     ) -> tuple[list[E.Expr], list[L.Formula], tuple[str, ...]] | None:
+    """The terms with a variable per function application (shared as in `abstracted`),
+    the facts those variables satisfy wherever `region` holds (ranges from its
+    conjuncts), and the variables: the states, then the new ones. None where a function
+    has no facts (log, sqrt: a variable alone says nothing)."""
+    table = _Table()
+    rewritten = [_replaced(term, table) for term in terms]
+    if any(func not in FACTS for func, _ in table.names):
+        return None
+    ranges = _Ranges(region)
+    facts = [fact for (func, argument), name in table.names.items()
+             for fact in FACTS[func](argument, E.Var(name), ranges.of(argument))]
+    return rewritten, facts, tuple(states) + tuple(table.names.values())
+
+
 class _Ranges:
     """Exact bounds of polynomial arguments over the box the query's conjuncts give
     their variables: the box that bounds all of the query's variables at once (a ball in
