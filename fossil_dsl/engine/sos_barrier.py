@@ -24,7 +24,7 @@ from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, field_of, interval_products, rounded,
                                    set_constraints)
-from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
+from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir.sets import Intersection
@@ -59,14 +59,19 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
         set_constraints(plan.spec.property.role("initial"), states)), n)
     unsafe = _padded(set_constraints(Intersection(plan.spec.property.role("unsafe"),
                                                   plan.spec.domain), states), n)
-    # with facts, B of degree 6 gave programs of tiny margins whose B failed (a05: 5 s)
-    for degree in DEGREES[:2] if facts else DEGREES:
+    # with facts, a quadratic B only, from small programs: those of higher degree gave
+    # tiny margins (a05: degree 6, 5 s lost) or B's the kernel's refutations (at most
+    # ATOMS_MAX_VARIABLES) could not prove (s12: degree 4, 8 s), and programs with many
+    # applications took 8 s (bbu09)
+    for degree in DEGREES[:1] if facts else DEGREES:
         for mu in DECAY_RATES:
             if time.monotonic() > deadline:
                 return None
             program = BarrierProgram(n, field, initial, [unsafe], domain, degree, mu,
                                      denominator, len(states))
-            if program.count > (MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES):
+            largest = ATOMS_MAX_VARIABLES if facts else \
+                MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES
+            if program.count > largest:
                 return None
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
             if x is None or x[program.margin] <= MIN_MARGIN:
