@@ -116,7 +116,12 @@ def _polynomial_problem(plan: Plan):
 
 def _padded(constraints: list[P.Polynomial], n: int) -> list[P.Polynomial]:
     """The constraints over the first variables as polynomials in n variables."""
-    return [{m + (0,) * (n - len(m)): c for m, c in g.items()} for g in constraints]
+    return [{_widened(m, n): c for m, c in g.items()} for g in constraints]
+
+
+def _widened(monomial: P.Monomial, n: int) -> P.Monomial:
+    """The monomial over the first variables as one over n (exponent 0 for the rest)."""
+    return monomial + (0,) * (n - len(monomial))
 
 
 class BarrierProgram(Program):
@@ -127,7 +132,7 @@ class BarrierProgram(Program):
                  states: int | None = None):
         super().__init__(n, searches=True)
         # B is over the first `states` variables (the rest stand for function values)
-        self.basis = [m + (0,) * (n - len(m)) for m in P.monomials(states or n, 0, 2 * degree)]
+        self.basis = [_widened(m, n) for m in P.monomials(states or n, 0, 2 * degree)]
         self.coefficients = self.unknown_polynomial(self.basis, 1.0)  # -1 <= b <= 1
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))

@@ -172,11 +172,8 @@ def abstracted(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tupl
     per distinct function application, named in the order they are first met."""
     table = _Table()
     body = _rewrite(query, table)
-    ranges = _Ranges(query)
-    facts = [fact for (func, argument), name in table.names.items()
-             if func in FACTS
-             for fact in FACTS[func](argument, E.Var(name), ranges.of(argument))]
-    return L.conjunction(body, *facts), tuple(states) + tuple(table.names.values())
+    return (L.conjunction(body, *_facts(table, _Ranges(query))),
+            tuple(states) + tuple(table.names.values()))
 
 
 def abstracted_terms(terms: Sequence[E.Expr], region: L.Formula, states: Sequence[str]
@@ -189,10 +186,13 @@ def abstracted_terms(terms: Sequence[E.Expr], region: L.Formula, states: Sequenc
     rewritten = [_replaced(term, table) for term in terms]
     if any(func not in FACTS for func, _ in table.names):
         return None
-    ranges = _Ranges(region)
-    facts = [fact for (func, argument), name in table.names.items()
-             for fact in FACTS[func](argument, E.Var(name), ranges.of(argument))]
-    return rewritten, facts, tuple(states) + tuple(table.names.values())
+    return rewritten, _facts(table, _Ranges(region)), tuple(states) + tuple(table.names.values())
+
+
+def _facts(table: "_Table", ranges: "_Ranges") -> list[L.Formula]:
+    """The facts of every application in the table that has any."""
+    return [fact for (func, argument), name in table.names.items() if func in FACTS
+            for fact in FACTS[func](argument, E.Var(name), ranges.of(argument))]
 
 
 class _Ranges:

@@ -187,7 +187,7 @@ class Program:
             # 9 s, 14 s with a run beside it)
             limit = seconds - spent if status == "InsufficientProgress" else \
                 min(seconds - spent, RETRY_SHARE * spent)
-        if str(solution.status) not in ("Solved", "AlmostSolved"):
+        if status not in ("Solved", "AlmostSolved"):
             return None
         return np.array(solution.x)
 
