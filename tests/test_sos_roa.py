@@ -111,3 +111,39 @@ def test_a_program_the_first_factorisation_stalls_on_is_solved_by_the_second():
     assert result.certified and result.kernel.certified, result.summary()
     assert result.strategy.startswith("sum-of-squares programming"), result.strategy
     assert "V of degree 4" in result.strategy, result.strategy
+
+
+SPECS = Path(__file__).resolve().parent.parent / "specs"
+INVERTED_INERTIA = """\
+state q, w
+dynamics continuous {
+    q' = w
+    w' = (-sin(q) - w)/(2 - cos(q)^2)
+}
+domain box([-1, -1], [1, 1])
+set init = ball([0, 0], 0.5)
+prove from init: stable
+"""
+
+
+@pytest.mark.parametrize("source", [
+    SPECS / "literature/lit31_rational_roa.fsl",  # rational: over one denominator
+    SPECS / "probe37/s10_tanh_3d_roa.fsl",  # tanh: a variable per application
+    INVERTED_INERTIA])  # sin and cos over 2 - cos(q)^2, a sign proved by Arb
+def test_a_field_that_is_not_polynomial_gets_its_region_from_the_program(source, monkeypatch):
+    # until session 62 the program was for polynomial fields only; the attempts before
+    # it are switched off so that it is the one that answers
+    from fossil_dsl.engine import basin, quadratic_roa
+    monkeypatch.setattr(quadratic_roa, "applies", lambda plan: False)
+    monkeypatch.setattr(basin, "applies", lambda plan: False)
+    spec = fossil_dsl.load(source) if isinstance(source, Path) else fossil_dsl.loads(source)
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=60)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming (Clarabel): V of degree")
+
+
+def test_a_field_with_sin_pushed_away_from_rest_gets_no_region():
+    pushed = INVERTED_INERTIA.replace("(-sin(q) - w)", "(2*sin(q) - w)")
+    plan = compile_spec(fossil_dsl.loads(pushed))
+    assert sos_roa.applies(plan)
+    assert sos_roa.search(plan, time.monotonic() + 30) is None

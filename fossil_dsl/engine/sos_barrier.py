@@ -20,17 +20,13 @@ from __future__ import annotations
 import time
 from fractions import Fraction
 
-from fossil_dsl.solvers.sdp import Program
-from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, field_of, interval_products, rounded,
-                                   set_constraints)
-from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
+from fossil_dsl.engine.polynomial_field import padded, polynomial_field, widened
+from fossil_dsl.engine.sos import MIN_MARGIN, SosFinding, interval_products, rounded, set_constraints
 from fossil_dsl.ir import polynomials as P
-from fossil_dsl.ir import traversal
 from fossil_dsl.ir.sets import Intersection
-from fossil_dsl.solvers.atom_facts import abstracted_terms
-from fossil_dsl.solvers.positivstellensatz import comparisons
 from fossil_dsl.plan.compile import Plan
+from fossil_dsl.solvers.sdp import Program
+from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
 
 # B of degree 2 first, then 4 and 6 where the program is not too large (before I's box
 # entered with its products, bb25 and probe48/c09 (6 states) needed quartic barriers,
@@ -54,10 +50,10 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
     # has; the products (x - l)(u - x) >= 0 bring the -x^2 terms (probe61/ag03, a
     # 6-state chain of masses with tanh friction: a quadratic B, else none). D's products
     # made the flow condition's programs larger for nothing (probe61/af11: 0.4 -> 2 s)
-    domain = _padded(set_constraints(plan.spec.domain, states), n) + facts
-    initial = _padded(interval_products(
+    domain = padded(set_constraints(plan.spec.domain, states), n) + facts
+    initial = padded(interval_products(
         set_constraints(plan.spec.property.role("initial"), states)), n)
-    unsafe = _padded(set_constraints(Intersection(plan.spec.property.role("unsafe"),
+    unsafe = padded(set_constraints(Intersection(plan.spec.property.role("unsafe"),
                                                   plan.spec.domain), states), n)
     # with facts, a quadratic B only, from small programs: those of higher degree gave
     # tiny margins (a05: degree 6, 5 s lost) or B's the kernel's refutations (at most
@@ -87,41 +83,13 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
 
 
 def _polynomial_problem(plan: Plan):
-    """(variables, field, denominator, facts) of the program: the states and a polynomial
-    field (1 as the denominator); a rational field over one denominator Q > 0 on D; or,
-    for a field with sin, tanh, exp, ..., the states and a variable per application,
-    the field in them, and the facts every application satisfies on D (atom_facts.py;
-    the flow condition then holds for every function obeying them, the true one among
-    them). None where none applies."""
-    states = plan.states
-    field = field_of(plan)
-    if field is not None:
-        return len(states), field, P.constant(1, len(states)), []
-    if all(traversal.is_arithmetic(f) for f in plan.spec.dynamics):
-        found = over_one_denominator(plan.spec.dynamics, states,
-                                     plan.spec.domain.bounding_box(), plan.options.seed)
-        return None if found is None else (len(states), found[0], found[1], [])
-    found = abstracted_terms(plan.spec.dynamics, plan.spec.domain.contains_formula(states),
-                             states)
-    if found is None:
-        return None
-    terms, facts, names = found
-    try:
-        field = [P.polynomial(term, names) for term in terms]
-        constraints = [h for fact in facts for h, _ in comparisons(fact, names)]
-    except ValueError:  # not polynomial after all (a rational argument, say)
-        return None
-    return len(names), field, P.constant(1, len(names)), constraints
-
-
-def _padded(constraints: list[P.Polynomial], n: int) -> list[P.Polynomial]:
-    """The constraints over the first variables as polynomials in n variables."""
-    return [{_widened(m, n): c for m, c in g.items()} for g in constraints]
-
-
-def _widened(monomial: P.Monomial, n: int) -> P.Monomial:
-    """The monomial over the first variables as one over n (exponent 0 for the rest)."""
-    return monomial + (0,) * (n - len(monomial))
+    """(variables, field, denominator, facts) of the program (polynomial_field.py), or
+    None."""
+    spec = plan.spec
+    found = polynomial_field(spec.dynamics, spec.domain.contains_formula(plan.states),
+                             plan.states, spec.domain.bounding_box(), plan.options.seed)
+    return None if found is None else (found.variables, found.numerators,
+                                       found.denominator, found.facts)
 
 
 class BarrierProgram(Program):
@@ -132,7 +100,7 @@ class BarrierProgram(Program):
                  states: int | None = None):
         super().__init__(n, searches=True)
         # B is over the first `states` variables (the rest stand for function values)
-        self.basis = [_widened(m, n) for m in P.monomials(states or n, 0, 2 * degree)]
+        self.basis = [widened(m, n) for m in P.monomials(states or n, 0, 2 * degree)]
         self.coefficients = self.unknown_polynomial(self.basis, 1.0)  # -1 <= b <= 1
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))

@@ -1,7 +1,9 @@
-"""A sum-of-squares attempt for a region of attraction (`from I: stable`) of a polynomial
-system, with inputs closed by a linear controller fixed beforehand to an LQR gain of the
-linearisation, rounded as the verifier will see it: where no quadratic V fits, a quartic
-one often does.
+"""A sum-of-squares attempt for a region of attraction (`from I: stable`), with inputs
+closed by a linear controller fixed beforehand to an LQR gain of the linearisation,
+rounded as the verifier will see it: where no quadratic V fits, a quartic one often
+does. The closed loop is polynomial, or N / Q with Q > 0 on D and, for an ODE with sin,
+tanh, exp, ..., a variable per application bounded by its facts (polynomial_field.py):
+the decrease is then asked as -grad V . N >= e|x|^2 for every value the facts allow.
 
 Why: a sublevel set of a quadratic V that holds I and lies in D is an ellipsoid the
 closed loop keeps; for a chain of integrators none fits between a ball and a box of a few
@@ -30,6 +32,8 @@ from fractions import Fraction
 import numpy as np
 
 from fossil_dsl.engine.linear import operating_point
+from fossil_dsl.engine.polynomial_field import (PolynomialField, padded, polynomial_field,
+                                               widened)
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.sos import (Inexact, faces, interval_products, rounded, set_constraints,
                                    squared_norm)
@@ -39,7 +43,7 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan, default_synthesis
 from fossil_dsl.solvers.sdp import Program
-from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
+from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
 
 HALF_DEGREES = (1, 2)  # V of degree 2, then 4
 CONTROLLERS = 2  # LQR gains tried, at most (u02: the first one's quartic has margin 0.1)
@@ -62,16 +66,14 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     discrete = plan.spec.time is TimeDomain.DISCRETE
     controllers = lqr_controllers(plan, operating, np.random.default_rng(plan.options.seed))
     for controller, gain in itertools.islice(controllers, CONTROLLERS):
-        try:
-            field = [P.polynomial(traversal.substitute(f, controller), states)
-                     for f in plan.spec.dynamics]
-        except P.NotPolynomial:
+        field = _closed_loop(plan, controller, discrete)
+        if field is None:
             return None
         for half in HALF_DEGREES:
             if time.monotonic() > deadline:
                 return None
-            program = _RegionProgram(len(states), field, *sets, half, discrete)
-            if program.count > MAX_VARIABLES:
+            program = _RegionProgram(field, len(states), *sets, half, discrete)
+            if program.count > (ATOMS_MAX_VARIABLES if field.facts else MAX_VARIABLES):
                 break
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
             if x is not None and x[program.margin] > MIN_MARGIN:
@@ -79,6 +81,19 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
                                     gain, operating, 2 * half, float(x[program.margin]),
                                     time.monotonic() - started, {"beta": LEVEL})
     return None
+
+
+def _closed_loop(plan: Plan, controller, discrete: bool) -> PolynomialField | None:
+    """The closed loop's polynomial form; for a map, polynomial maps only (V(f(x)) of a
+    quotient is not polynomial)."""
+    spec, states = plan.spec, plan.states
+    terms = [traversal.substitute(f, controller) for f in spec.dynamics]
+    field = polynomial_field(terms, spec.domain.contains_formula(states), states,
+                             spec.domain.bounding_box(), plan.options.seed)
+    if field is None or (discrete and field.variables > len(states)) \
+            or (discrete and P.degree(field.denominator) > 0):
+        return None
+    return field
 
 
 def _sets(plan: Plan):
@@ -93,24 +108,28 @@ def _sets(plan: Plan):
 
 
 class _RegionProgram(Program):
-    def __init__(self, n: int, field, domain, initial, half: int, discrete: bool):
+    def __init__(self, field: PolynomialField, states: int, domain, initial, half: int,
+                 discrete: bool):
+        n = field.variables
         super().__init__(n, searches=True)
-        self.basis = P.monomials(n, 2, 2 * half)
+        # V is over the states; the rest of the variables stand for function values
+        self.basis = [widened(m, n) for m in P.monomials(states, 2, 2 * half)]
         self.coefficients = self.unknown_polynomial(self.basis, BOUND)
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))
         terms = [{m: Fraction(1)} for m in self.basis]
         v = list(zip(self.coefficients, terms))
         minus_v = [(c, P.scale(t, -1)) for c, t in v]
-        norm = squared_norm(n)
+        norm = padded([squared_norm(states)], n)[0]
         one = P.constant(1, n)
-        inside = interval_products(domain)
+        inside = padded(interval_products(domain), n)
         self.require_nonnegative(v, inside, (self.margin, norm))
-        self.require_nonnegative(minus_v, initial, (self.margin, one), one)
+        self.require_nonnegative(minus_v, padded(initial, n), (self.margin, one), one)
         for face in faces(domain):
-            self.require_nonnegative(v, face, (self.margin, one), P.scale(one, -1))
-        decrease = [(c, P.scale(P.change(t, field, discrete), -1)) for c, t in v]
-        self.require_nonnegative(decrease, inside, (self.margin, norm))
+            self.require_nonnegative(v, padded(face, n), (self.margin, one), P.scale(one, -1))
+        # over N = f Q with Q > 0: -grad V . N >= e|x|^2 gives dV/dt <= -e|x|^2 / Q
+        decrease = [(c, P.scale(P.change(t, field.numerators, discrete), -1)) for c, t in v]
+        self.require_nonnegative(decrease, inside + field.facts, (self.margin, norm))
 
     def exact_v(self, x) -> P.Polynomial:
         return rounded(x, self.basis, self.coefficients, DECIMALS)

@@ -37,6 +37,7 @@ from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.rational import numerator
 from fossil_dsl.ir.expr import add, neg
 from fossil_dsl.solvers.atom_facts import abstracted, has_atoms
+from fossil_dsl.solvers.cleared import cleared
 
 
 @dataclass(frozen=True)
@@ -163,7 +164,7 @@ def polynomial_form(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula,
     query satisfies (atom_facts.py): a refutation of that one refutes the query."""
     if not has_atoms(query):
         return query, tuple(states)
-    return abstracted(query, states)
+    return abstracted(cleared(query), states)
 
 
 def refutation_problem(refutation: Evidence, query: L.Formula,

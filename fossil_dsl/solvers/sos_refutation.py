@@ -26,6 +26,7 @@ from fossil_dsl.ir import traversal
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.solvers.api import Answer, Status
 from fossil_dsl.solvers.atom_facts import has_atoms, replaceable
+from fossil_dsl.solvers.cleared import cleared
 from fossil_dsl.solvers.gram_rounding import (MULTIPLIER_DECIMALS, decimal, projected,
                                              psd_square, settled)
 from fossil_dsl.solvers.positivstellensatz import (CaseSplit, Evidence, Power, Product,
@@ -216,9 +217,9 @@ def opposite_pairs(polynomials) -> list[tuple[int, int]]:
 
 def _least_abstracted_size(query: L.Formula, states) -> int:
     """_smallest_size for the query's polynomial form, estimated from its expressions as
-    they are (no expansion): a variable per distinct application, and the syntactic
-    degree bound with each application counted as degree 1."""
-    sides = [side for c in L.comparisons(query) for side in (c.left, c.right)]
+    they are, divisions cleared (no expansion): a variable per distinct application, and
+    the syntactic degree bound with each application counted as degree 1."""
+    sides = [side for c in L.comparisons(cleared(query)) for side in (c.left, c.right)]
     replaced = {node for side in sides for node in E.walk(side) if replaceable(node)}
     return _gram_entries(len(states) + len(replaced), max(map(traversal.degree, sides)))
 
