@@ -186,3 +186,14 @@ def test_a_division_inside_a_divisor_must_be_proved_non_zero_too():
         divisor = E.div(E.add(E.Num(1), E.power(Y, E.Num(2))), Y)
         query = L.conjunction(box, L.Compare(">", E.div(X, divisor), E.Num(2)))
         assert (cleared(query) != query) == changed
+
+
+def test_a_constant_divisor_is_proved_without_a_box():
+    # pi - 3 > 0 and 3 - pi < 0 need no box; a divisor that is a constant expression
+    # inside a divisor is one of the guards too
+    inner = E.add(E.Pi(), E.Num(-3))
+    divisor = E.div(E.add(E.Num(1), E.power(X, E.Num(2))), inner)
+    query = L.conjunction(BOX, L.Compare(">", E.div(X, divisor), E.Num(1)))
+    rewritten = cleared(query)
+    assert not has_division(rewritten)
+    assert str(rewritten).endswith("x*(pi - 3) - x^2 - 1 > 0"), str(rewritten)

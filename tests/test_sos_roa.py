@@ -126,10 +126,23 @@ prove from init: stable
 """
 
 
+TANH_MAP = """\
+state x, y
+dynamics discrete {
+    next(x) = 0.5*tanh(x) + 0.2*y
+    next(y) = 0.5*y - 0.2*tanh(x)
+}
+domain box([-1, -1], [1, 1])
+set init = ball([0, 0], 0.5)
+prove from init: stable
+"""
+
+
 @pytest.mark.parametrize("source", [
     SPECS / "literature/lit31_rational_roa.fsl",  # rational: over one denominator
     SPECS / "probe37/s10_tanh_3d_roa.fsl",  # tanh: a variable per application
-    INVERTED_INERTIA])  # sin and cos over 2 - cos(q)^2, a sign proved by Arb
+    INVERTED_INERTIA,  # sin and cos over 2 - cos(q)^2, a sign proved by Arb
+    TANH_MAP])  # V(f(x)) with f polynomial in x and the variable for tanh(x)
 def test_a_field_that_is_not_polynomial_gets_its_region_from_the_program(source, monkeypatch):
     # until session 62 the program was for polynomial fields only; the attempts before
     # it are switched off so that it is the one that answers

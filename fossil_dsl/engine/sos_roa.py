@@ -84,14 +84,13 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
 
 
 def _closed_loop(plan: Plan, controller, discrete: bool) -> PolynomialField | None:
-    """The closed loop's polynomial form; for a map, polynomial maps only (V(f(x)) of a
-    quotient is not polynomial)."""
+    """The closed loop's polynomial form; for a map, one over the denominator 1 only
+    (V(f(x)) of a quotient is not polynomial)."""
     spec, states = plan.spec, plan.states
     terms = [traversal.substitute(f, controller) for f in spec.dynamics]
     field = polynomial_field(terms, spec.domain.contains_formula(states), states,
                              spec.domain.bounding_box(), plan.options.seed)
-    if field is None or (discrete and field.variables > len(states)) \
-            or (discrete and P.degree(field.denominator) > 0):
+    if field is None or (discrete and P.degree(field.denominator) > 0):
         return None
     return field
 

@@ -157,8 +157,10 @@ def to_expr(p: Mapping[Monomial, Fraction], states: Sequence[str]) -> E.Expr:
 
 
 def compose(p: Mapping[Monomial, Fraction], field: Sequence[Polynomial]) -> Polynomial:
-    """p(field(x)): the polynomial after one step of x+ = field(x)."""
-    n = len(field)
+    """p(field(x)): the polynomial after one step of x+ = field(x). The components may
+    have more variables than there are states (the variables for function values of
+    polynomial_field.py); p is then over the states' first ones only."""
+    n = next((len(m) for component in field for m in component), len(field))
     result: Polynomial = {}
     for monomial, coefficient in p.items():
         term = constant(coefficient, n)

@@ -69,7 +69,7 @@ def guards(expr: E.Expr):
     applications. Where none is 0, every division in expr is by a non-zero number, and
     fraction's identity holds; `fraction`'s factors are among them."""
     for node in _outside_applications(expr):
-        if isinstance(node, E.Div) and E.free_vars(node.denominator):
+        if isinstance(node, E.Div):  # (a number's sign is read off at once)
             yield fraction(node.denominator)[0]
         elif isinstance(node, E.Pow) and (_integer(node.exponent) or 0) < 0:
             yield fraction(node.base)[0]
@@ -186,14 +186,15 @@ class _Signs:
     def _proved(self, expr: E.Expr) -> int:
         if isinstance(expr, E.Num):
             return (expr.value > 0) - (expr.value < 0)
-        if self.box is None or any(lo > hi for lo, hi in self.box) \
-                or not E.free_vars(expr) <= set(self.names):
+        names, box = (self.names, self.box) if E.free_vars(expr) else ([], [])
+        if box is None or any(lo > hi for lo, hi in box) \
+                or not E.free_vars(expr) <= set(names):
             return 0
         import flint
         from fossil_dsl.solvers.arb_backend import _Refuter
-        refuter = _Refuter(flint.arb, self.names)
+        refuter = _Refuter(flint.arb, names)
         for sign, relation in ((1, "<="), (-1, ">=")):
-            if _refuted(refuter, L.Compare(relation, expr, E.ZERO), list(self.box)):
+            if _refuted(refuter, L.Compare(relation, expr, E.ZERO), list(box)):
                 return sign
         return 0
 
@@ -209,6 +210,8 @@ def _refuted(refuter, comparison: L.Compare, box) -> bool:
             return False
         if refuter.refutes(comparison, piece):
             continue
+        if not piece:  # a constant: nothing to bisect
+            return False
         widest = max(range(len(piece)), key=lambda i: piece[i][1] - piece[i][0])
         lo, hi = piece[widest]
         middle = (lo + hi) / 2
