@@ -159,12 +159,15 @@ def conjuncts(query: L.Formula) -> list[L.Formula]:
 
 
 def polynomial_form(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tuple]:
-    """The query and its variables; a query with elementary functions as the polynomial
-    query with a variable per function application and the facts every point of the
-    query satisfies (atom_facts.py): a refutation of that one refutes the query."""
+    """The query and its variables, its comparisons multiplied through the divisors whose
+    signs Arb proves (cleared.py; the others are left to `comparisons`' form); a query
+    with elementary functions as the polynomial query with a variable per function
+    application and the facts every point of the query satisfies (atom_facts.py): a
+    refutation of that one refutes the query."""
+    query = cleared(query)
     if not has_atoms(query):
         return query, tuple(states)
-    return abstracted(cleared(query), states)
+    return abstracted(query, states)
 
 
 def refutation_problem(refutation: Evidence, query: L.Formula,
