@@ -14,6 +14,7 @@ from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
+from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.atom_facts import abstracted_terms
 from fossil_dsl.solvers.cleared import common_denominator
 from fossil_dsl.solvers.positivstellensatz import comparisons
@@ -27,17 +28,20 @@ class PolynomialField:
     facts: list  # g >= 0 over all the variables: what the applications satisfy on D
 
 
-def polynomial_field(terms, region: L.Formula, states, box, seed: int
-                     ) -> PolynomialField | None:
-    """The field's polynomial form on the region (see the module's text); None where the
-    field has a function with no facts (log, sqrt) or a denominator of unknown sign."""
+def exact_field(plan: Plan, terms) -> PolynomialField | None:
+    """The field `terms` (the spec's, or its closed loop) in polynomial form on D (see the
+    module's text; exact, unlike surrogate.py's fitted stand-in); None where it has a
+    function with no facts (log, sqrt) or a denominator of unknown sign."""
+    spec, states = plan.spec, plan.states
+    region = spec.domain.contains_formula(states)
     n = len(states)
     try:
         return PolynomialField(n, [P.polynomial(f, states) for f in terms], P.constant(1, n), [])
     except P.NotPolynomial:
         pass
     if all(traversal.is_arithmetic(f) for f in terms):
-        found = over_one_denominator(terms, states, box, seed)
+        found = over_one_denominator(terms, states, spec.domain.bounding_box(),
+                                     plan.options.seed)
         return None if found is None else PolynomialField(n, found[0], found[1], [])
     over = common_denominator(terms, region)
     if over is None:

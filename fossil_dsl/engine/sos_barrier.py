@@ -20,8 +20,9 @@ from __future__ import annotations
 import time
 from fractions import Fraction
 
-from fossil_dsl.engine.polynomial_field import padded, polynomial_field, widened
-from fossil_dsl.engine.sos import MIN_MARGIN, SosFinding, interval_products, rounded, set_constraints
+from fossil_dsl.engine.polynomial_field import exact_field, padded, widened
+from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, interval_products, rounded,
+                                   set_constraints)
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.plan.compile import Plan
@@ -41,10 +42,10 @@ DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 def barrier(plan: Plan, deadline: float) -> SosFinding | None:
     started = time.monotonic()
     states = plan.states
-    problem = _polynomial_problem(plan)
-    if problem is None:
+    field = exact_field(plan, plan.spec.dynamics)
+    if field is None:
         return None
-    n, field, denominator, facts = problem
+    n, facts = field.variables, field.facts
     # I with its box's products: -B - e >= 0 on I with constant multipliers of I's
     # linear bounds needs -B's Hessian to be PSD, which no quadratic B positive on U
     # has; the products (x - l)(u - x) >= 0 bring the -x^2 terms (probe61/ag03, a
@@ -63,8 +64,8 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
         for mu in DECAY_RATES:
             if time.monotonic() > deadline:
                 return None
-            program = BarrierProgram(n, field, initial, [unsafe], domain, degree, mu,
-                                     denominator, len(states))
+            program = BarrierProgram(n, field.numerators, initial, [unsafe], domain, degree,
+                                     mu, field.denominator, len(states))
             largest = ATOMS_MAX_VARIABLES if facts else \
                 MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES
             if program.count > largest:
@@ -80,16 +81,6 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
                                                        "by their facts)" if facts else ""),
                               time.monotonic() - started)
     return None
-
-
-def _polynomial_problem(plan: Plan):
-    """(variables, field, denominator, facts) of the program (polynomial_field.py), or
-    None."""
-    spec = plan.spec
-    found = polynomial_field(spec.dynamics, spec.domain.contains_formula(plan.states),
-                             plan.states, spec.domain.bounding_box(), plan.options.seed)
-    return None if found is None else (found.variables, found.numerators,
-                                       found.denominator, found.facts)
 
 
 class BarrierProgram(Program):

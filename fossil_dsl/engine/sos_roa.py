@@ -32,8 +32,7 @@ from fractions import Fraction
 import numpy as np
 
 from fossil_dsl.engine.linear import operating_point
-from fossil_dsl.engine.polynomial_field import (PolynomialField, padded, polynomial_field,
-                                               widened)
+from fossil_dsl.engine.polynomial_field import PolynomialField, exact_field, padded, widened
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.sos import (Inexact, faces, interval_products, rounded, set_constraints,
                                    squared_norm)
@@ -86,10 +85,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
 def _closed_loop(plan: Plan, controller, discrete: bool) -> PolynomialField | None:
     """The closed loop's polynomial form; for a map, one over the denominator 1 only
     (V(f(x)) of a quotient is not polynomial)."""
-    spec, states = plan.spec, plan.states
-    terms = [traversal.substitute(f, controller) for f in spec.dynamics]
-    field = polynomial_field(terms, spec.domain.contains_formula(states), states,
-                             spec.domain.bounding_box(), plan.options.seed)
+    field = exact_field(plan, [traversal.substitute(f, controller) for f in plan.spec.dynamics])
     if field is None or (discrete and P.degree(field.denominator) > 0):
         return None
     return field

@@ -73,14 +73,44 @@ def _search(refuter, formula, start, deadline: float, stop) -> Answer:
         if refuter.refutes(formula, box):
             continue
         widest = max(range(len(box)), key=lambda i: (box[i][1] - box[i][0]) / smallest[i])
-        lo, hi = box[widest]
-        middle = (lo + hi) / 2
-        if not lo < middle < hi or hi - lo < smallest[widest]:
-            return Answer(Status.UNKNOWN, reason=f"a box of width {hi - lo:.3g} is not "
-                          "refuted (the query may hold there)")
-        stack.append(box[:widest] + [(middle, hi)] + box[widest + 1:])
-        stack.append(box[:widest] + [(lo, middle)] + box[widest + 1:])
+        halves = _halves(box, widest)
+        if halves is None or box[widest][1] - box[widest][0] < smallest[widest]:
+            return Answer(Status.UNKNOWN, reason=f"a box of width "
+                          f"{box[widest][1] - box[widest][0]:.3g} is not refuted (the query "
+                          "may hold there)")
+        stack += halves
     return Answer(Status.UNSAT, solver=ArbBackend.name)
+
+
+def refuted_on(formula: L.Formula, names: Sequence[str], box, pieces: int) -> bool:
+    """Whether no point of the box satisfies the formula, shown on at most `pieces`
+    pieces, each bisected on its widest side: a count, not a clock, so the same call
+    gives the same answer (solvers/cleared.py's proofs of a divisor's sign, which the
+    kernel's check redoes)."""
+    import flint
+    refuter, stack = _Refuter(flint.arb, list(names)), [list(box)]
+    for _ in range(pieces):
+        if not stack:
+            return True
+        piece = stack.pop()
+        if refuter.refutes(formula, piece):
+            continue
+        halves = _halves(piece, max(range(len(piece)), key=lambda i: piece[i][1] - piece[i][0])) \
+            if piece else None  # (a constant has nothing to bisect)
+        if halves is None:
+            return False
+        stack += halves
+    return not stack
+
+
+def _halves(box, i: int):
+    """The box cut in two across side i (the upper half first, so the lower is taken
+    next from a stack), or None where the side cannot be cut in floats."""
+    lo, hi = box[i]
+    middle = (lo + hi) / 2
+    if not lo < middle < hi:
+        return None
+    return [box[:i] + [(middle, hi)] + box[i + 1:], box[:i] + [(lo, middle)] + box[i + 1:]]
 
 
 class _Refuter:

@@ -8,8 +8,9 @@ depth (`guards`, the D_k among them) proved on the box the query's own conjuncts
 its variables (Arb's ball arithmetic on at most SIGN_PIECES pieces of the box: the
 count, not a clock, so a check redoes the same proof). Every point of the query lies in
 the box, where no divisor is 0, so there l - r and N / prod D_k are the same number and
-the rewritten comparison holds exactly where the old one does. Function applications are kept whole (a division inside sin(x/y) stays
-there). Comparisons whose denominators' signs are not proved stay as they are.
+the rewritten comparison holds exactly where the old one does. Function applications
+are kept whole (a division inside sin(x/y) stays there). Comparisons whose divisors'
+signs are not proved stay as they are.
 
 Why: the equations of a mechanical system with its mass matrix inverted (a cart-pole,
 a two-link arm) divide by 4/3 - m cos(q)^2 / M; a Lyapunov condition over them is a
@@ -151,8 +152,7 @@ def _rewrite(formula: L.Formula, signs: "_Signs") -> L.Formula:
 
 
 def _cleared_comparison(comparison: L.Compare, signs: "_Signs") -> L.Compare:
-    if comparison.relation not in FLIPPED \
-            or not (_divides(comparison.left) or _divides(comparison.right)):
+    if not (_divides(comparison.left) or _divides(comparison.right)):
         return comparison
     difference = E.add(comparison.left, E.neg(comparison.right))
     numerator, factors = fraction(difference)
@@ -190,33 +190,8 @@ class _Signs:
         if box is None or any(lo > hi for lo, hi in box) \
                 or not E.free_vars(expr) <= set(names):
             return 0
-        import flint
-        from fossil_dsl.solvers.arb_backend import _Refuter
-        refuter = _Refuter(flint.arb, names)
+        from fossil_dsl.solvers.arb_backend import refuted_on
         for sign, relation in ((1, "<="), (-1, ">=")):
-            if _refuted(refuter, L.Compare(relation, expr, E.ZERO), list(box)):
+            if refuted_on(L.Compare(relation, expr, E.ZERO), names, box, SIGN_PIECES):
                 return sign
         return 0
-
-
-def _refuted(refuter, comparison: L.Compare, box) -> bool:
-    """Whether no point of the box satisfies the comparison, shown on at most
-    SIGN_PIECES pieces (each bisected on its widest side)."""
-    stack, pieces = [box], 0
-    while stack:
-        piece = stack.pop()
-        pieces += 1
-        if pieces > SIGN_PIECES:
-            return False
-        if refuter.refutes(comparison, piece):
-            continue
-        if not piece:  # a constant: nothing to bisect
-            return False
-        widest = max(range(len(piece)), key=lambda i: piece[i][1] - piece[i][0])
-        lo, hi = piece[widest]
-        middle = (lo + hi) / 2
-        if not lo < middle < hi:
-            return False
-        stack.append(piece[:widest] + [(middle, hi)] + piece[widest + 1:])
-        stack.append(piece[:widest] + [(lo, middle)] + piece[widest + 1:])
-    return True
