@@ -3,6 +3,7 @@ every fact holds where it is claimed to (checked against sympy's values at 60 di
 independent of the Arb enclosures the facts' constants come from), the polynomial query
 keeps every point of the original, a refutation proves, and what is false stays
 unproved."""
+import math
 import time
 from fractions import Fraction as F
 from pathlib import Path
@@ -222,3 +223,42 @@ def test_the_first_quadratic_v_gets_a_program_large_enough_for_a_quadrotor():
     # refutations may take 3000 (engine/attempts.py), and it is certified by them
     path = Path(__file__).resolve().parent.parent / "specs/probe44/y12_planar_quadrotor_roa_ctrl.fsl"
     _decrease_refuted(fossil_dsl.load(path), timeout=60)
+
+
+def _sublevel_query(argument: E.Expr):
+    """x^2 + x y + y^2 - 1 <= 0 (cross term: no axis-parallel ellipsoid), tanh(argument)
+    above 2 (so the query is about the argument's range only)."""
+    x, y = E.Var("x"), E.Var("y")
+    quadratic = E.add(E.power(x, E.Num(F(2))), E.mul(x, y), E.power(y, E.Num(F(2))),
+                      E.Num(F(-1)))
+    return L.conjunction(L.Compare("<=", quadratic, E.Num(F(0))),
+                         L.Compare(">", E.apply("tanh", argument), E.Num(F(2))))
+
+
+def test_a_linear_argument_gets_its_range_on_a_quadratic_sublevel_set():
+    """probe58/ab04: tanh(-K x) on a V <= 0 with cross terms. On x^2 + xy + y^2 <= 1,
+    x + y reaches 2/sqrt(3) = 1.155 (at x = y); the per-variable box (|x|, |y| <=
+    2/sqrt(3)) alone gives 2.31. The range is tight and holds every point of the set."""
+    from fossil_dsl.solvers.atom_facts import _Ranges
+    x, y = E.Var("x"), E.Var("y")
+    argument = E.add(x, y, E.Num(F(1, 2)))
+    low, high = _Ranges(_sublevel_query(argument)).of(argument)
+    assert 0.5 + 2 / 3 ** 0.5 <= high <= 0.5 + 2 / 3 ** 0.5 + 1e-6
+    assert 0.5 - 2 / 3 ** 0.5 - 1e-6 <= low <= 0.5 - 2 / 3 ** 0.5
+    angles = [k * 0.01 for k in range(629)]
+    for a in angles:  # the boundary: (u, v) on the unit circle mapped onto the ellipse
+        u, v = math.cos(a), math.sin(a)
+        px = (u / 1.5 ** 0.5 + v / 0.5 ** 0.5) / 2 ** 0.5
+        py = (u / 1.5 ** 0.5 - v / 0.5 ** 0.5) / 2 ** 0.5
+        assert abs(px * px + px * py + py * py - 1) < 1e-9
+        assert low <= px + py + 0.5 <= high
+
+
+def test_a_sublevel_set_that_is_not_an_ellipsoid_gives_no_quadratic_range():
+    from fossil_dsl.solvers.atom_facts import _Ranges
+    x, y = E.Var("x"), E.Var("y")
+    saddle = E.add(E.power(x, E.Num(F(2))), E.mul(E.Num(F(3)), x, y),
+                   E.power(y, E.Num(F(2))), E.Num(F(-1)))  # indefinite: unbounded
+    query = L.conjunction(L.Compare("<=", saddle, E.Num(F(0))),
+                          L.Compare(">", E.apply("tanh", E.add(x, y)), E.Num(F(2))))
+    assert _Ranges(query).of(E.add(x, y)) is None

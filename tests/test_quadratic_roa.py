@@ -93,3 +93,51 @@ def test_an_swa_whose_omega_meets_u_gets_no_candidate():
     """f26 (false): orbits round a centre from I pass through U; the linearisation is
     not asymptotically stable, and no Ω of a quadratic misses U while holding I."""
     assert _candidates(ROOT / "specs" / "false" / "f26_swa_center.fsl") == []
+
+
+SATURATED = ROOT / "specs" / "probe58" / "ab04_saturated_double_integrators_rwa_ctrl_4d.fsl"
+
+
+def _reach_candidates(path: Path) -> list:
+    plan = compile_spec(fossil_dsl.load(path))
+    assert quadratic_roa.reaches(plan) and not quadratic_roa.applies(plan)
+    return list(quadratic_roa.candidates(plan, float("inf")))
+
+
+def test_saturated_actuators_get_a_reach_v_from_the_ellipsoid_with_a_small_gain(tmp_path):
+    """probe58/ab04: two sampled double integrators behind tanh(u), RWA (timeout in
+    120 s before). The ellipsoid of the default gain weight has |u| up to 1.6, where
+    tanh bends and V grows; the one with gain weight 0.1 keeps |u| <= 0.8, and V = k
+    (x^T P x - β) falls by 10 γ at its samples. Its decrease is refuted with tanh's
+    sector over the range of -K x on {V <= 0} (atom_facts.py)."""
+    found = _reach_candidates(SATURATED)
+    assert found and set(found[0].formulas) == {"V"} and set(found[0].controller) == {"u1", "u2"}
+    assert found[0].levels == {}
+    result = fossil_dsl.synthesise(fossil_dsl.load(SATURATED), seed=0, timeout=60)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("the linearisation's quadratic V and a linear controller")
+    result.save(tmp_path / "saturated")
+    checks = recheck(tmp_path / "saturated", timeout=30)
+    assert checks and all(c.reproved for c in checks), checks
+
+
+def test_the_ellipsoid_keeps_out_of_an_unsafe_half_space():
+    """ab04's U = {p1 + p2 >= 2.5}: a'Q a <= s b^2 puts the ellipsoid {x^T P x <= 1}
+    (which holds I's corners with p1 = p2 = 1.1) strictly on the safe side."""
+    from fossil_dsl.engine.ellipsoid_seed import ellipsoids
+    from fossil_dsl.engine.linear import jacobians, operating_point
+    spec = fossil_dsl.load(SATURATED)
+    A, B = jacobians(spec, operating_point(spec))
+    shapes = list(ellipsoids(A, B, spec, discrete=True))
+    assert len(shapes) == 2  # one per gain weight
+    a = np.array([1.0, 0.0, 1.0, 0.0])
+    for P, _ in shapes:
+        assert np.sqrt(a @ np.linalg.inv(P) @ a) < 2.5  # max of p1 + p2 on the ellipsoid
+
+
+def test_false_reach_properties_get_no_reach_candidate():
+    """A goal beside the equilibrium, a wall across the way, an uncontrollable mode:
+    no Ω of a quadratic both holds I and lies in S with V falling outside G."""
+    for name in ("f05_rwa_wrong_goal", "f24_rwa_wall", "f52_uncontrollable_mode_rwa",
+                 "f70_offset_equilibrium_rwa"):
+        assert _reach_candidates(ROOT / "specs" / "false" / f"{name}.fsl") == [], name

@@ -65,7 +65,8 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
                              (sos.applies, _sum_of_squares),
                              (quadratic_roa.applies, _quadratic_region),
                              (sos_roa.applies, _region_sum_of_squares),
-                             (sos_reach.applies, _reach_sum_of_squares)):
+                             (sos_reach.applies, _reach_sum_of_squares),
+                             (quadratic_roa.reaches, _quadratic_region)):
         if backend is not None and applies(plan):
             found, note = attempt(plan, backend, listener, deadline)
             if found is not None:
@@ -183,8 +184,7 @@ def _repelling(plan: Plan, backend: Backend, listener, deadline: float):
 
 
 def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
-    """((plan with V given, β fixed and the controller set, certified outcome) or None,
-    what happened)."""
+    """((plan with V given, β fixed, the controller set, certified outcome) or None, why)."""
     listener.phase(0, "the linearisation's quadratic V")
     budget = time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
     note = "no quadratic V of the linearisation decreases where it holds I"

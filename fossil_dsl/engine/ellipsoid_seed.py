@@ -8,6 +8,7 @@ With Q = P^-1 and Y = K Q (u = K x), the classical linear matrix inequalities
     [[1, p^T], [p, Q]] >= 0 for each corner p of I's box   (I inside {V <= 1})
     Q >= r^2 I instead where I is a ball of radius r round the origin
     Q_ii <= s d_i^2                                (the ellipsoid inside s D, D a box or ball)
+    a^T Q a <= s b^2       (and away from an unsafe half-space {a^T x >= b}, b > 0)
     [[g, Y], [Y^T, Q]] >= 0  (|u| bounded on the ellipsoid, so the nonlinear terms stay small)
 
 are solved for the smallest s + w g (Clarabel, through solvers/sdp.py). Where s < 1, {V <= 1} holds I and
@@ -28,8 +29,11 @@ from fossil_dsl.solvers.sdp import Program
 # is what the verifier needs (a cart-pole's decrease with a = 0.1 was left UNKNOWN after
 # 60 s; with a = 1, dV/dt <= -1.8 V on the samples)
 DECAYS = (3.0, 1.0, 0.5, 0.3, 0.1)
-CONTRACTIONS = (0.7, 0.85, 0.95)
-GAIN_WEIGHT = 1e-3  # w: how much a small |u| counts against a small ellipsoid
+CONTRACTIONS = (0.7, 0.85, 0.95, 0.98)
+# w: how much a small |u| counts against a small ellipsoid; the second where the first's
+# candidate fails (probe58/ab04, tanh-saturated inputs: |u| <= 1.6 on the first
+# ellipsoid, V grows at samples; <= 0.8 on the second, which is certified)
+GAIN_WEIGHTS = (1e-3, 0.1)
 MAX_CORNERS = 256  # I's box in at most 8 states
 SECONDS = 5.0  # for the solver
 # s at most this: the sampled level between I and D needs room (with a = 1 a cart-pole's
@@ -38,7 +42,8 @@ SECONDS = 5.0  # for the solver
 ROOM = 0.8
 
 
-def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
+def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool,
+              weight: float = GAIN_WEIGHTS[0]):
     """(P, K) with u = K x for the strongest rate whose s is at most ROOM (else the
     weakest feasible one), or None where the sets are not boxes or balls round the
     origin's neighbourhood, or the inequalities are infeasible, or s >= 1."""
@@ -48,10 +53,25 @@ def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
     corners = np.empty((0, len(A))) if radius else _corners(initial, len(A))
     if half_widths is None or corners is None:
         return None
+    planes = _unsafe_planes(spec)
+    return _strongest(lambda rate: _solve(A, B, half_widths, corners, radius, discrete,
+                                          rate, planes, weight), discrete)
+
+
+def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
+    """ellipsoid()'s (P, K) for each of GAIN_WEIGHTS (one without inputs): the later
+    ones keep |u| smaller on the ellipsoid (a saturating actuator's tanh(u) near u)."""
+    for weight in GAIN_WEIGHTS[:len(GAIN_WEIGHTS) if B.shape[1] else 1]:
+        found = ellipsoid(A, B, spec, discrete, weight)
+        if found is not None:
+            yield found
+
+
+def _strongest(solve, discrete: bool):
     last = None
     for rate in CONTRACTIONS if discrete else DECAYS:
         try:
-            found = _solve(A, B, half_widths, corners, radius, discrete, rate)
+            found = solve(rate)
         except (ValueError, np.linalg.LinAlgError):  # numerical trouble: no seed
             return None
         if found is not None and found[2] <= ROOM:
@@ -89,6 +109,25 @@ def _ball_radius(initial) -> float | None:
     return None if np.any(low + high) else float(high[0])
 
 
+def _unsafe_planes(spec) -> list[tuple[np.ndarray, float]]:
+    """(a, b) for an unsafe set that is one half-space {a^T x >= b} missing the origin
+    (a sampled sublevel set of a symmetric ellipsoid holding I can reach into it: a
+    bound on x1 + x2 where I lies at x1 = x2 = 1.1); else none."""
+    from fossil_dsl.engine.sos import Inexact, set_constraints
+    from fossil_dsl.ir import polynomials as P
+    unsafe = spec.property.role("unsafe")
+    try:
+        constraints = [] if unsafe is None else set_constraints(unsafe, spec.states, True)
+    except Inexact:
+        return []
+    if len(constraints) != 1 or P.degree(constraints[0]) != 1:
+        return []
+    g, n = constraints[0], len(spec.states)  # g = a^T x - b >= 0 on U
+    a = np.array([float(g.get(tuple(int(i == k) for i in range(n)), 0)) for k in range(n)])
+    b = -float(g.get((0,) * n, 0))
+    return [(a, b)] if b > 0 else []
+
+
 def _corners(initial, n: int) -> np.ndarray | None:
     box = initial.bounding_box() if initial is not None else None
     if box is None or 2 ** n > MAX_CORNERS:
@@ -96,7 +135,8 @@ def _corners(initial, n: int) -> np.ndarray | None:
     return np.array(list(itertools.product(*zip(box[0], box[1]))), dtype=float)
 
 
-def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float):
+def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float,
+           planes=(), weight: float = GAIN_WEIGHTS[0]):
     n, m = B.shape
     lmi = _Inequalities(n)
     Q = lmi.symmetric(n)  # positive semidefinite
@@ -122,7 +162,10 @@ def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float):
     for i in range(n):
         forms, _ = Q[i][i]
         lmi.at_most.append(({**forms, s: -float(d[i]) ** 2}, 0.0))
-    x = lmi.solve({s: 1.0, g: GAIN_WEIGHT}, SECONDS)
+    for a, b in planes:  # a^T Q a - s b^2 <= 0
+        lmi.at_most.append((_sum([_scaled(Q[i][j], a[i] * a[j]) for i in range(n)
+                                  for j in range(n)] + [({s: -b ** 2}, 0.0)])[0], 0.0))
+    x = lmi.solve({s: 1.0, g: weight}, SECONDS)
     if x is None or x[s] >= 1:
         return None
     Qv = np.array([[_value(Q[i][j], x) for j in range(n)] for i in range(n)])

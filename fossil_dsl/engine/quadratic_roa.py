@@ -26,7 +26,7 @@ from fossil_dsl.engine.sampling import sample
 from fossil_dsl.engine.trajectories import numeric_field
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
-from fossil_dsl.ir.sets import Intersection
+from fossil_dsl.ir.sets import Boundary, Intersection
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan, default_synthesis
 
@@ -38,6 +38,10 @@ SIGNIFICANT = 6  # digits kept of P's entries
 UNSAFE_SAMPLES = 2000  # of U within D (stable while avoid): V > β there
 # stable while avoid takes B = V - β: Ω cannot be left, so it is a barrier where it misses U
 FORMS = ("region of attraction", "stable while avoid")
+# and reach (while avoid) takes V = k (x^T P x - β): Ω lies in S, and outside G (round the
+# origin) V falls by at least γ once k is large enough
+REACH_FORMS = ("reach while avoid", "reach")
+REACH_MARGIN = 10.0  # k makes V fall by this many times γ at the slowest sample of Ω \ G
 
 
 @dataclass(frozen=True)
@@ -56,9 +60,18 @@ class QuadraticFinding:
 
 
 def applies(plan: Plan) -> bool:
-    spec = plan.spec
-    return (plan.certificate.form in FORMS and default_synthesis(plan)
-            and not plan.options.largest_region and spec.domain.bounding_box() is not None)
+    return plan.certificate.form in FORMS and _default(plan)
+
+
+def reaches(plan: Plan) -> bool:
+    """For reach and RWA: tried after the reach program, which is quicker to a proof
+    where it finds V (two quadratic candidates refuted first cost specs/discrete/d08 10 s)."""
+    return plan.certificate.form in REACH_FORMS and _default(plan)
+
+
+def _default(plan: Plan) -> bool:
+    return (default_synthesis(plan) and not plan.options.largest_region
+            and plan.spec.domain.bounding_box() is not None)
 
 
 def candidates(plan: Plan, deadline: float):
@@ -81,21 +94,29 @@ def candidates(plan: Plan, deadline: float):
                 [traversal.substitute(f, controller) for f in spec.dynamics], plan.states)
         shape = None if P is None else _exact_shape(P)
         level = None if shape is None else _level(plan, shape)
-        if level is not None and _decreases(plan, field, shape, level, discrete, rng) \
-                and _misses_unsafe(plan, shape, level, rng):
-            V = _quadratic(shape, plan.states)
-            formulas = {"V": V} if plan.certificate.form == FORMS[0] else \
-                {"V": V, "B": E.add(V, E.Num(-level))}
-            yield QuadraticFinding(formulas, controller, gain, operating, {"beta": level},
-                                   time.monotonic() - started)
+        if level is None or not _decreases(plan, field, shape, level, discrete, rng) \
+                or not _misses_unsafe(plan, shape, level, rng):
+            continue
+        V = _quadratic(shape, plan.states)
+        if plan.certificate.form in REACH_FORMS:
+            V = _reaching(plan, field, shape, level, discrete, rng)
+            if V is not None:
+                yield QuadraticFinding({"V": V}, controller, gain, operating, {},
+                                       time.monotonic() - started)
+            continue
+        formulas = {"V": V} if plan.certificate.form == FORMS[0] else \
+            {"V": V, "B": E.add(V, E.Num(-level))}
+        yield QuadraticFinding(formulas, controller, gain, operating, {"beta": level},
+                               time.monotonic() - started)
 
 
 def _shapes(plan: Plan, A: np.ndarray, B: np.ndarray, operating: np.ndarray, rng):
     """(controller, its gain, P) in turn: the Lyapunov matrices of the first LQR gain's
     closed loop (identity weights), the ellipsoid between I and D that the linearisation
     keeps (ellipsoid_seed.py; where the LQR ellipsoids are flat, every sublevel set that
-    holds I leaves D), then the other LQR gains' Lyapunov matrices."""
-    from fossil_dsl.engine.ellipsoid_seed import ellipsoid
+    holds I leaves D; with inputs, again with a smaller gain), then the other LQR gains'
+    Lyapunov matrices."""
+    from fossil_dsl.engine.ellipsoid_seed import ellipsoids
     from fossil_dsl.engine.linear import lyapunov_matrix
     from fossil_dsl.engine.quadratic_shapes import exact_controller, lqr_controllers
     spec = plan.spec
@@ -107,9 +128,8 @@ def _shapes(plan: Plan, A: np.ndarray, B: np.ndarray, operating: np.ndarray, rng
             for Q in _weightings(len(A), rng):
                 yield controller, gain, lyapunov_matrix(closed, discrete, Q)
         if index == 0:
-            found = ellipsoid(A, B if spec.inputs else np.zeros((len(A), 0)), spec, discrete)
-            if found is not None:
-                P, K = found
+            for P, K in ellipsoids(A, B if spec.inputs else np.zeros((len(A), 0)), spec,
+                                   discrete):
                 controller, gain = exact_controller(spec, K, operating, plan.options.digits) \
                     if spec.inputs else ({}, None)
                 yield controller, gain, P
@@ -179,19 +199,53 @@ def _decreases(plan: Plan, field, shape, level: Fraction, discrete: bool, rng) -
     """V decreases (and, for a map, f(x) stays in D) at samples of Ω and of its shell."""
     P = _floats(shape)
     points = _ellipsoid_points(P, float(level), rng)
+    change, image = _change(field, P, points, discrete)
+    if discrete and not np.all(_inside(plan, plan.spec.domain, image)):
+        return False
+    return bool(np.all(change < 0))
+
+
+def _change(field, P: np.ndarray, points: np.ndarray, discrete: bool):
+    """(x^T P x's change at the points: its step for a map, else its derivative; the
+    field's values there)."""
     with np.errstate(all="ignore"):
         image = field(points)
-        values = np.einsum("bi,ij,bj->b", points, P, points)
         if discrete:
-            change = np.einsum("bi,ij,bj->b", image, P, image) - values
-            in_domain = holds(plan.spec.domain.contains_formula(plan.states),
-                              state_env(plan.states, np.nan_to_num(image, nan=1e9)),
-                              len(points))
-            if not np.all(np.asarray(in_domain, bool)):
-                return False
+            change = np.einsum("bi,ij,bj->b", image, P, image) - \
+                np.einsum("bi,ij,bj->b", points, P, points)
         else:
             change = 2 * np.einsum("bi,ij,bj->b", points, P, image)
-    return bool(np.all(change < 0))
+    return change, image
+
+
+def _inside(plan: Plan, region, points: np.ndarray) -> np.ndarray:
+    env = state_env(plan.states, np.nan_to_num(points, nan=1e9))
+    return np.asarray(holds(region.contains_formula(plan.states), env, len(points)), bool)
+
+
+def _reaching(plan: Plan, field, shape, level: Fraction, discrete: bool, rng):
+    """k (x^T P x - β) with V's change at most -REACH_MARGIN γ at the samples of Ω
+    outside G, where G holds the origin and Ω (and, for a map, every step from it) lies
+    in S at the samples; else None."""
+    from fossil_dsl.plan.certificates.rwa import GAMMA
+    prop, P = plan.spec.property, _floats(shape)
+    safe, goal = prop.role("safe") or plan.spec.domain, prop.role("goal")
+    if not _inside(plan, goal, np.zeros((1, len(P))))[0]:
+        return None  # V would have to fall by γ next to the equilibrium
+    # V falls slowest next to G: its boundary's samples too
+    edge = np.asarray(sample(Boundary(goal), plan.states, SHELL, rng,
+                             plan.spec.domain.bounding_box()), float).reshape(-1, len(P))
+    edge = edge[np.einsum("bi,ij,bj->b", edge, P, edge) <= float(level)]
+    points = _ellipsoid_points(P, float(level), rng)
+    points = np.concatenate([points[~_inside(plan, goal, points)], edge])
+    change, image = _change(field, P, points, discrete)
+    if not (np.all(_inside(plan, safe, points)) and len(points) and np.all(change < 0)):
+        return None
+    if discrete and not np.all(_inside(plan, safe, image)):
+        return None
+    k = Fraction(f"{REACH_MARGIN * float(GAMMA) / float(-change.max()):.3g}")
+    scaled = [[k * entry for entry in row] for row in shape]
+    return E.add(_quadratic(scaled, plan.states), E.Num(-k * level))
 
 
 def _ellipsoid_points(P: np.ndarray, level: float, rng) -> np.ndarray:

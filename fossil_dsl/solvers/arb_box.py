@@ -138,12 +138,27 @@ def _ellipsoid_bounds(polynomial: dict, names):
 
 
 def quadratic_bounds(polynomial: dict, names):
-    """For p(x) = x^T A x + b^T x + k <= 0 over the variables p has, A positive definite
-    (shown exactly, by the pivots of its LDL^T factorisation): with c = -A^-1 b / 2 and
-    R = b^T A^-1 b / 4 - k, p <= 0 is (x - c)^T A (x - c) <= R, on which x_i - c_i
-    reaches at most sqrt(R (A^-1)_ii). [] for any other p."""
-    if any(sum(m) > 2 for m in polynomial):
+    """For p(x) = x^T A x + b^T x + k <= 0 over the variables p has, A positive definite:
+    the bounds of each x_i on the ellipsoid (quadratic_ellipsoid); [] for any other p."""
+    found = quadratic_ellipsoid(polynomial, names)
+    if found is None:
         return []
+    used, inverse, centre, radius = found
+    bounds = []
+    for row, v in enumerate(used):
+        reach = Fraction(sqrt_up(radius * inverse[row][row]))
+        bounds.append((v, _down(centre[row] - reach), _up(centre[row] + reach)))
+    return bounds
+
+
+def quadratic_ellipsoid(polynomial: dict, names):
+    """For p(x) = x^T A x + b^T x + k over the variables p has, A positive definite
+    (shown exactly, by the pivots of its LDL^T factorisation): (those variables' names,
+    A^-1, c = -A^-1 b / 2, R = b^T A^-1 b / 4 - k), so that p <= 0 is (x - c)^T A (x - c)
+    <= R, on which a linear b^T x reaches b^T c -+ sqrt(R b^T A^-1 b); None for any other
+    p (or R < 0), all exact."""
+    if any(sum(m) > 2 for m in polynomial):
+        return None
     used = sorted({i for m in polynomial for i, k in enumerate(m) if k})
     where = {v: row for row, v in enumerate(used)}
     A = [[Fraction(0)] * len(used) for _ in used]
@@ -160,18 +175,24 @@ def quadratic_bounds(polynomial: dict, names):
         else:
             i, j = where[present[0]], where[present[1]]
             A[i][j] = A[j][i] = c / 2
-    inverse = _positive_definite_inverse(A)
+    inverse = _positive_definite_inverse(A) if used else None
     if inverse is None:
-        return []
+        return None
     n = len(used)
     centre = [-sum(inverse[i][j] * b[j] for j in range(n)) / 2 for i in range(n)]
     radius = sum(b[i] * inverse[i][j] * b[j] for i in range(n) for j in range(n)) / 4 - k
-    if radius < 0:
-        return []
+    return None if radius < 0 else ([names[v] for v in used], inverse, centre, radius)
+
+
+def quadratic_ellipsoids(formula: L.Formula, names) -> list[tuple]:
+    """quadratic_ellipsoid() of every conjunct p(x) <= 0 with a positive definite
+    quadratic p (a sublevel set {V <= β} of a quadratic V, cross terms and all)."""
     found = []
-    for row, v in enumerate(used):
-        reach = Fraction(sqrt_up(radius * inverse[row][row]))
-        found.append((names[v], _down(centre[row] - reach), _up(centre[row] + reach)))
+    for atom in _conjuncts(formula):
+        polynomial = _at_most_zero(atom, names)
+        ellipsoid = None if polynomial is None else quadratic_ellipsoid(polynomial, names)
+        if ellipsoid is not None:
+            found.append(ellipsoid)
     return found
 
 
