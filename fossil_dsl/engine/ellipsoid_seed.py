@@ -30,10 +30,12 @@ from fossil_dsl.solvers.sdp import Program
 # 60 s; with a = 1, dV/dt <= -1.8 V on the samples)
 DECAYS = (3.0, 1.0, 0.5, 0.3, 0.1)
 CONTRACTIONS = (0.7, 0.85, 0.95, 0.98)
-# w: how much a small |u| counts against a small ellipsoid; the second where the first's
-# candidate fails (probe58/ab04, tanh-saturated inputs: |u| <= 1.6 on the first
-# ellipsoid, V grows at samples; <= 0.8 on the second, which is certified)
-GAIN_WEIGHTS = (1e-3, 0.1)
+# w: how much a small |u| counts against a small ellipsoid; the later ones where the
+# earlier candidates fail: tanh-saturated inputs need |u| where tanh(u) is nearly u
+# (probe58/ab04: |u| <= 1.6 on the first ellipsoid, V grows at samples, 0.8 on the
+# second, certified; probe63/ak04: 1.1 on the second, tanh's sector [0.73, 1] lets V
+# grow, 0.25 on the third, certified)
+GAIN_WEIGHTS = (1e-3, 0.1, 1.0)
 MAX_CORNERS = 256  # I's box in at most 8 states
 SECONDS = 5.0  # for the solver
 # s at most this: the sampled level between I and D needs room (with a = 1 a cart-pole's
@@ -59,8 +61,8 @@ def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool,
 
 
 def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
-    """ellipsoid()'s (P, K) for each of GAIN_WEIGHTS (one without inputs): the later
-    ones keep |u| smaller on the ellipsoid (a saturating actuator's tanh(u) near u)."""
+    """ellipsoid()'s (P, K) for each of GAIN_WEIGHTS (the first alone without inputs):
+    the later ones keep |u| smaller on the ellipsoid (a saturating tanh(u) near u)."""
     for weight in GAIN_WEIGHTS[:len(GAIN_WEIGHTS) if B.shape[1] else 1]:
         found = ellipsoid(A, B, spec, discrete, weight)
         if found is not None:
