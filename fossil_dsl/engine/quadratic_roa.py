@@ -97,13 +97,13 @@ def candidates(plan: Plan, deadline: float):
         if level is None or not _decreases(plan, field, shape, level, discrete, rng) \
                 or not _misses_unsafe(plan, shape, level, rng):
             continue
-        V = _quadratic(shape, plan.states)
         if plan.certificate.form in REACH_FORMS:
             V = _reaching(plan, field, shape, level, discrete, rng)
             if V is not None:
                 yield QuadraticFinding({"V": V}, controller, gain, operating, {},
                                        time.monotonic() - started)
             continue
+        V = _quadratic(shape, plan.states)
         formulas = {"V": V} if plan.certificate.form == FORMS[0] else \
             {"V": V, "B": E.add(V, E.Num(-level))}
         yield QuadraticFinding(formulas, controller, gain, operating, {"beta": level},

@@ -131,25 +131,21 @@ def _defined_everywhere(node: E.Expr, states) -> bool:
 def folded(formula: L.Formula, states: Sequence[str]) -> L.Formula:
     """The formula with each comparison whose sides differ by a number (over the atoms)
     replaced by that number's comparison with 0 (then `L.truth` decides it)."""
-    if isinstance(formula, L.Compare):
-        difference = E.add(formula.left, E.neg(formula.right))
-        if isinstance(difference, E.Num):
-            return L.Compare(formula.relation, difference, E.ZERO)
-        nodes = list(E.walk(difference))
-        if len(nodes) > MAX_NODES or not any(_is_atom(n, states) for n in nodes):
-            return formula  # (the solvers decide polynomials exactly)
-        polynomial, _ = over_atoms(difference, states)
-        if any(any(monomial) for monomial in polynomial):
-            return formula
-        value = next(iter(polynomial.values()), Fraction(0))  # the constant term, or 0
-        return L.Compare(formula.relation, E.Num(value), E.ZERO)
-    if isinstance(formula, L.And):
-        return L.conjunction(*(folded(a, states) for a in formula.args))
-    if isinstance(formula, L.Or):
-        return L.disjunction(*(folded(a, states) for a in formula.args))
-    if isinstance(formula, L.Not):
-        return L.negation(folded(formula.arg, states))
-    return formula
+    return L.map_comparisons(formula, lambda c: _folded_comparison(c, states))
+
+
+def _folded_comparison(comparison: L.Compare, states: Sequence[str]) -> L.Compare:
+    difference = E.add(comparison.left, E.neg(comparison.right))
+    if isinstance(difference, E.Num):
+        return L.Compare(comparison.relation, difference, E.ZERO)
+    nodes = list(E.walk(difference))
+    if len(nodes) > MAX_NODES or not any(_is_atom(n, states) for n in nodes):
+        return comparison  # (the solvers decide polynomials exactly)
+    polynomial, _ = over_atoms(difference, states)
+    if any(any(monomial) for monomial in polynomial):
+        return comparison
+    value = next(iter(polynomial.values()), Fraction(0))  # the constant term, or 0
+    return L.Compare(comparison.relation, E.Num(value), E.ZERO)
 
 
 def _is_atom(node: E.Expr, states) -> bool:

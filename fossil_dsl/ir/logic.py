@@ -165,17 +165,22 @@ def free_vars(formula: Formula) -> frozenset[str]:
     return frozenset(names)
 
 
-def substitute(formula: Formula, mapping) -> Formula:
+def map_comparisons(formula: Formula, change) -> Formula:
+    """The formula with each comparison c replaced by change(c), its and/or/not kept."""
     if isinstance(formula, Compare):
-        return Compare(formula.relation, expr_substitute(formula.left, mapping),
-                       expr_substitute(formula.right, mapping))
+        return change(formula)
     if isinstance(formula, And):
-        return conjunction(*(substitute(a, mapping) for a in formula.args))
+        return conjunction(*(map_comparisons(a, change) for a in formula.args))
     if isinstance(formula, Or):
-        return disjunction(*(substitute(a, mapping) for a in formula.args))
+        return disjunction(*(map_comparisons(a, change) for a in formula.args))
     if isinstance(formula, Not):
-        return negation(substitute(formula.arg, mapping))
+        return negation(map_comparisons(formula.arg, change))
     return formula
+
+
+def substitute(formula: Formula, mapping) -> Formula:
+    return map_comparisons(formula, lambda c: Compare(
+        c.relation, expr_substitute(c.left, mapping), expr_substitute(c.right, mapping)))
 
 
 def boundary_outer(formula: Formula) -> Formula:

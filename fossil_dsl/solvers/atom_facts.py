@@ -172,7 +172,8 @@ def abstracted(query: L.Formula, states: Sequence[str]) -> tuple[L.Formula, tupl
     """The polynomial query (the module's text) and its variables: the states, then one
     per distinct function application, named in the order they are first met."""
     table = _Table()
-    body = _rewrite(query, table)
+    body = L.map_comparisons(query, lambda c: L.Compare(
+        c.relation, _replaced(c.left, table), _replaced(c.right, table)))
     return (L.conjunction(body, *_facts(table, _Ranges(query))),
             tuple(states) + tuple(table.names.values()))
 
@@ -293,19 +294,6 @@ class _Table:
         if key not in self.names:
             self.names[key] = f"{ATOM_PREFIX}{func}{len(self.names)}"
         return E.Var(self.names[key])
-
-
-def _rewrite(formula: L.Formula, table: _Table) -> L.Formula:
-    if isinstance(formula, L.Compare):
-        return L.Compare(formula.relation, _replaced(formula.left, table),
-                         _replaced(formula.right, table))
-    if isinstance(formula, L.And):
-        return L.conjunction(*[_rewrite(arg, table) for arg in formula.args])
-    if isinstance(formula, L.Or):
-        return L.disjunction(*[_rewrite(arg, table) for arg in formula.args])
-    if isinstance(formula, L.Not):
-        return L.negation(_rewrite(formula.arg, table))
-    return formula
 
 
 def _replaced(expr: E.Expr, table: _Table) -> E.Expr:

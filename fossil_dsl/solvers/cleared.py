@@ -38,7 +38,8 @@ def cleared(query: L.Formula) -> L.Formula:
     the module's text); the query itself where there is nothing to clear."""
     if not has_division(query):
         return query
-    return _rewrite(query, _Signs(query))
+    signs = _Signs(query)
+    return L.map_comparisons(query, lambda c: _cleared_comparison(c, signs))
 
 
 def fraction(expr: E.Expr) -> tuple[E.Expr, tuple[E.Expr, ...]]:
@@ -137,18 +138,6 @@ def _divides(expr: E.Expr) -> bool:
     if isinstance(expr, E.Apply):
         return False
     return any(_divides(child) for child in E.children(expr))
-
-
-def _rewrite(formula: L.Formula, signs: "_Signs") -> L.Formula:
-    if isinstance(formula, L.Compare):
-        return _cleared_comparison(formula, signs)
-    if isinstance(formula, L.And):
-        return L.conjunction(*[_rewrite(arg, signs) for arg in formula.args])
-    if isinstance(formula, L.Or):
-        return L.disjunction(*[_rewrite(arg, signs) for arg in formula.args])
-    if isinstance(formula, L.Not):
-        return L.negation(_rewrite(formula.arg, signs))
-    return formula
 
 
 def _cleared_comparison(comparison: L.Compare, signs: "_Signs") -> L.Compare:
