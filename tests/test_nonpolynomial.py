@@ -449,3 +449,21 @@ def test_a_leader_that_does_not_stop_is_left_behind_at_its_time_limit(monkeypatc
     assert time.monotonic() - started < 3  # not the 20 s the leader takes
     assert answer.status is Status.UNKNOWN
     assert "z3 had not stopped 0.3 s past its time limit" in answer.reason
+
+
+def test_an_exported_tanh_is_read_back_as_tanh():
+    """The printer writes tanh(z) as (e^2z - 1) / (e^2z + 1). Read back as that
+    quotient, a re-check lost tanh's sector facts and Arb's direct enclosure (probe64/am04's
+    decrease: no refutation, and Arb left boxes after 60 s); as tanh, the sector
+    refutes a query that the quotient's facts do not."""
+    from fossil_dsl.solvers.sos_refutation import SosBackend
+    x, y = E.Var("x"), E.Var("y")
+    inner = E.add(E.mul(E.Num(Fraction(1, 2)), x), y)
+    # on the unit box z tanh(z) >= 0 everywhere: z tanh(z) < -1/100 has no point
+    query = L.conjunction(L.Compare("<=", E.Num(-1), x), L.Compare("<=", x, E.Num(1)),
+                          L.Compare("<=", E.Num(-1), y), L.Compare("<=", y, E.Num(1)),
+                          L.Compare("<", E.mul(inner, E.apply("tanh", inner)),
+                                    E.Num(Fraction(-1, 100))))
+    read = read_script(query_text(query, ["x", "y"]))
+    assert read.formula == query
+    assert SosBackend().check(read.formula, read.variables, 10).status is Status.UNSAT

@@ -13,6 +13,8 @@ from fossil_dsl.engine import sos_roa
 from fossil_dsl.engine.attempts import _set_up
 from fossil_dsl.engine.loop import as_listener
 from fossil_dsl.engine.proving import prove_found
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import traversal
 from fossil_dsl.plan.compile import compile_spec
 from fossil_dsl.solvers import registry
 
@@ -160,3 +162,95 @@ def test_a_field_with_sin_pushed_away_from_rest_gets_no_region():
     plan = compile_spec(fossil_dsl.loads(pushed))
     assert sos_roa.applies(plan)
     assert sos_roa.search(plan, time.monotonic() + 30) is None
+
+
+# the reversed Van der Pol oscillator: its unstable limit cycle (closest to the origin at
+# 1.53) lies in D, so no V falls on all of D; I is a ball of 1.4
+WIDE_VAN_DER_POL = SPECS / "probe64/am03_reversed_van_der_pol_wide_roa.fsl"
+
+
+def test_a_domain_holding_a_limit_cycle_gets_its_region_with_the_multiplier():
+    """Before session 64 the program asked dV/dt < 0 on all of D and found nothing;
+    learning gave up after 25 iterations. With -dV/dt >= λ|x|^2 (1 - V) V may grow
+    outside Ω, and a sextic V is proved with no ball left out."""
+    plan = compile_spec(fossil_dsl.load(WIDE_VAN_DER_POL))
+    finding = sos_roa.search(plan, time.monotonic() + 60)
+    assert finding is not None and finding.degree == 6, finding
+    result = fossil_dsl.synthesise(fossil_dsl.load(WIDE_VAN_DER_POL), seed=0, timeout=60)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming (Clarabel): V of degree 6")
+    assert "converges to the origin" in result.kernel.guarantee
+    assert "ε-stability" not in result.kernel.guarantee
+
+
+def test_without_the_multiplier_no_v_falls_on_a_domain_holding_a_limit_cycle(monkeypatch):
+    monkeypatch.setattr(sos_roa, "MULTIPLIER_FACTORS", ())
+    plan = compile_spec(fossil_dsl.load(WIDE_VAN_DER_POL))
+    assert sos_roa.search(plan, time.monotonic() + 60) is None
+
+
+def test_the_multiplier_is_scaled_by_the_decay_and_the_size_of_i():
+    """2α / r^2: the reversed Van der Pol's linearisation decays at α = 1/2 and I's box
+    reaches 1.4 on each axis, so r^2 = 2 * 1.4^2."""
+    plan = compile_spec(fossil_dsl.load(WIDE_VAN_DER_POL))
+    scale = sos_roa._multiplier_scale(plan, None, None, discrete=False)
+    assert scale == pytest.approx(2 * 0.5 / (2 * 1.4 ** 2))
+    shapes = sos_roa._shapes(plan, None, None, discrete=False)
+    assert shapes[:2] == [(1, 0.0), (2, 0.0)]  # V falling on all of D is tried first
+    assert {w for _, w in shapes[2:]} == {f * scale for f in sos_roa.MULTIPLIER_FACTORS}
+
+
+def test_an_unstable_system_gets_no_region_with_the_multiplier_either():
+    plan = compile_spec(fossil_dsl.loads(UNSTABLE))
+    assert sos_roa._multiplier_scale(plan, None, None, discrete=False) is None
+    outward = UNSTABLE.replace("x1' = x1 + x2", "x1' = -x1 + x2").replace(
+        "x2' = x2 - x1^3", "x2' = -x2 + x1^2 + x2^3")
+    # stable at 0, but (simulated) a trajectory from the ball of 0.95 leaves D
+    plan = compile_spec(fossil_dsl.loads(outward.replace("0.3)", "0.95)")))
+    assert sos_roa.search(plan, time.monotonic() + 60) is None
+
+
+REACTOR = SPECS / "probe64/am05_cstr_jacket_stable_ctrl_3d.fsl"
+
+
+def test_a_stand_in_keeps_the_linearisation_and_vanishes_at_the_origin():
+    """probe64/am05: the least-squares fit of T' has a constant of -2.9e-4 (and of c',
+    7.3e-5), so no V decreases next to the origin for it; the fit anchored at the
+    Jacobian keeps f(0) = 0 and f'(0) (to 8 digits) and fits the rest."""
+    import numpy as np
+    from fossil_dsl.engine.linear import jacobians
+    from fossil_dsl.engine.surrogate import polynomial_field
+    from fossil_dsl.ir import polynomials as P
+    spec = fossil_dsl.load(REACTOR)
+    field = [traversal.substitute(f, {"u": E.Num(0)}) for f in spec.dynamics]
+    A = jacobians(spec)[0]
+    fitted = polynomial_field(field, spec.states, spec.domain, (3, 5), 0, A)
+    assert fitted is not None
+    for row, polynomial in zip(A, fitted):
+        assert P.constant(0, 3) == {m: c for m, c in polynomial.items() if sum(m) == 0}
+        slopes = [float(polynomial.get(tuple(int(i == k) for i in range(3)), 0))
+                  for k in range(3)]
+        assert np.allclose(slopes, row, atol=1e-7)
+
+
+def test_a_reactor_with_an_arrhenius_term_gets_a_quartic_v_from_the_stand_in():
+    """probe64/am05: the facts of exp(T/(1 + 0.05 T)) (a variable between its tangent and
+    nothing above near 0) leave every program infeasible; the anchored stand-in's quartic
+    V decreases for the true closed loop at every sample of its Ω."""
+    import numpy as np
+    import sympy
+    from fossil_dsl.ir.symbolic import to_sympy
+    plan = compile_spec(fossil_dsl.load(REACTOR))
+    finding = sos_roa.search(plan, time.monotonic() + 60)
+    assert finding is not None and finding.stand_in and finding.degree == 4, finding
+    symbols = {s: sympy.Symbol(s) for s in (*plan.states, *plan.spec.inputs)}
+    x = [symbols[s] for s in plan.states]
+    V = to_sympy(finding.formulas["V"], symbols)
+    field = [to_sympy(traversal.substitute(f, finding.controller), symbols)
+             for f in plan.spec.dynamics]
+    change = sympy.lambdify(x, sum(sympy.diff(V, v) * f for v, f in zip(x, field)))
+    level = sympy.lambdify(x, V)
+    points = np.random.default_rng(0).uniform(-0.6, 0.6, size=(100_000, 3))
+    inside = (level(*points.T) <= 1) & (np.linalg.norm(points, axis=1) > 0.01)
+    assert inside.sum() > 1000
+    assert change(*points[inside].T).max() < 0

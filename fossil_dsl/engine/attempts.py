@@ -15,8 +15,8 @@ from dataclasses import replace
 from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos, sos_reach,
                                sos_roa, torch_import)
 from fossil_dsl.engine.given import verifier_only
-from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, STAND_IN_QUERY_SECONDS, NotSetUp,
-                                       only_function, prove_found, verify_given)
+from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, budgets, only_function,
+                                       prove_found, verify_given)
 from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, as_listener
 from fossil_dsl.ir import traversal
@@ -200,14 +200,15 @@ def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
 
 
 def _region_proved(plan: Plan, backend: Backend, listener, deadline: float, finding,
-                   refuting: float, atoms_limit: int = ATOMS_MAX_VARIABLES):
+                   refuting: float, atoms_limit: int = ATOMS_MAX_VARIABLES,
+                   querying: float = SOS_QUERY_SECONDS):
     """(plan with V given, β fixed and the controller set, certified outcome) or None,
     and what happened: proved with the Taylor lemma's ball, else with the plan's own."""
     lemma = _lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
     note = ""
     for attempt in _lemma_then_own(lemma, plan):
         found, note = prove_found(attempt, backend, listener, deadline, finding, refuting,
-                                  formulas=finding.formulas, atoms_limit=atoms_limit,
+                                  querying, finding.formulas, atoms_limit=atoms_limit,
                                   prepare=functools.partial(_set_up, finding=finding))
         if found is not None:
             return found, ""
@@ -221,8 +222,9 @@ def _region_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: flo
                                sos_roa.search)
     if finding is None:
         return None, "no sum-of-squares region of attraction found"
-    return _region_proved(plan, backend, listener, deadline, finding,
-                          max(REACH_REFUTING_SECONDS, 2 * finding.seconds))
+    refuting, querying = budgets(finding, REACH_REFUTING_SECONDS)
+    return _region_proved(plan, backend, listener, deadline, finding, refuting,
+                          querying=querying)
 
 
 def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
@@ -272,15 +274,9 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
         return None, "no sum-of-squares reach certificate found"
     if not finding.degree:  # RAR's B alone
         return _learned_beside(plan, backend, listener, deadline, finding)
-    # for a stand-in's V the conditions with elementary functions are proved by the
-    # solvers (probe55/p07: interval), and where the stand-in misled the program the
-    # solvers' pass finds that in a fraction of a second (probe48/c03: 5 s of refuting
-    # to no end before)
-    refuting = 2 * finding.seconds if finding.stand_in else \
-        max(REACH_REFUTING_SECONDS, 2 * finding.seconds)
-    querying = STAND_IN_QUERY_SECONDS if finding.stand_in else SOS_QUERY_SECONDS
-    return prove_found(plan, backend, listener, deadline, finding, refuting, querying,
-                       finding.formulas, prepare=lambda cegis: _set_up(cegis, finding))
+    return prove_found(plan, backend, listener, deadline, finding,
+                       *budgets(finding, REACH_REFUTING_SECONDS), finding.formulas,
+                       prepare=lambda cegis: _set_up(cegis, finding))
 
 
 def _learned_beside(plan: Plan, backend: Backend, listener, deadline: float, finding):

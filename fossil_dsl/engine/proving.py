@@ -24,6 +24,17 @@ SOS_QUERY_SECONDS = 5.0
 STAND_IN_QUERY_SECONDS = 15.0
 
 
+def budgets(finding, floor: float) -> tuple[float, float]:
+    """(seconds of refutations, seconds per solver query) for a program's functions: for
+    a stand-in's, the conditions with elementary functions are proved by the solvers
+    (probe55/p07: interval), and where the stand-in misled the program the solvers' pass
+    finds that in a fraction of a second (probe48/c03: 5 s of refuting to no end before);
+    else twice the program's time, at least `floor`."""
+    if finding.stand_in:
+        return 2 * finding.seconds, STAND_IN_QUERY_SECONDS
+    return max(floor, 2 * finding.seconds), SOS_QUERY_SECONDS
+
+
 class NotSetUp(Exception):
     """A found function's companion (a controller) could not be given to the loop."""
 

@@ -7,8 +7,10 @@ its shell {V = β}; the decrease asked of P is Q = I, then random diagonal weigh
 
 The attempt is for `from I: stable` (no `region: largest`, which shapes V to the
 simulated basin) and `from I: stable and always not U`, with B = V - β where Ω misses U
-(Ω cannot be left, so {B <= 0} cannot either). A learner whose level is halfway between I and ∂D, or whose margin
-is large against a small V, misses such a pair (probe53/n01, an excitable neuron: the
+(Ω cannot be left, so {B <= 0} cannot either); for reach, RWA and RAR, V = k (x^T P x - β)
+falling by 10 γ at the samples (and RAR's B the same x^T P x's sublevel set just holding
+G, inside F). A learner whose level is halfway between I and ∂D, or whose margin is large
+against a small V, misses such a pair (probe53/n01, an excitable neuron: the
 Lyapunov equation's V holds at β = 1.05 times its largest value on I and fails at the
 halfway level). Nothing here is trusted: V and β are proved like any candidate.
 """
@@ -40,7 +42,8 @@ UNSAFE_SAMPLES = 2000  # of U within D (stable while avoid): V > β there
 FORMS = ("region of attraction", "stable while avoid")
 # and reach (while avoid) takes V = k (x^T P x - β): Ω lies in S, and outside G (round the
 # origin) V falls by at least γ once k is large enough
-REACH_FORMS = ("reach while avoid", "reach")
+REACH_FORMS = ("reach while avoid", "reach", "reach-avoid-remain")
+# and RAR's B = x^T P x - b: b just over its largest value on G, {B <= 0} inside F
 REACH_MARGIN = 10.0  # k makes V fall by this many times γ at the slowest sample of Ω \ G
 
 
@@ -98,9 +101,9 @@ def candidates(plan: Plan, deadline: float):
                 or not _misses_unsafe(plan, shape, level, rng):
             continue
         if plan.certificate.form in REACH_FORMS:
-            V = _reaching(plan, field, shape, level, discrete, rng)
-            if V is not None:
-                yield QuadraticFinding({"V": V}, controller, gain, operating, {},
+            formulas = _reach_formulas(plan, field, shape, level, discrete, rng)
+            if formulas is not None:
+                yield QuadraticFinding(formulas, controller, gain, operating, {},
                                        time.monotonic() - started)
             continue
         V = _quadratic(shape, plan.states)
@@ -221,6 +224,32 @@ def _change(field, P: np.ndarray, points: np.ndarray, discrete: bool):
 def _inside(plan: Plan, region, points: np.ndarray) -> np.ndarray:
     env = state_env(plan.states, np.nan_to_num(points, nan=1e9))
     return np.asarray(holds(region.contains_formula(plan.states), env, len(points)), bool)
+
+
+def _reach_formulas(plan: Plan, field, shape, level: Fraction, discrete: bool, rng):
+    """{"V": V} (and RAR's "B") from the shape, or None where either fails its samples."""
+    V = _reaching(plan, field, shape, level, discrete, rng)
+    if V is None or plan.certificate.form != REACH_FORMS[2]:
+        return None if V is None else {"V": V}
+    B = _remaining(plan, field, shape, discrete, rng)
+    return None if B is None else {"V": V, "B": B}
+
+
+def _remaining(plan: Plan, field, shape, discrete: bool, rng):
+    """RAR's B = x^T P x - b, b just over its largest value on G, where {B <= 0} lies in F
+    and x^T P x falls at the samples of that set (and, for a map, each step from it
+    lands in D); else None."""
+    from fossil_dsl.engine.quadratic_shapes import boundary_floor, set_ceiling
+    prop, P = plan.spec.property, _floats(shape)
+    centre = np.zeros(len(P))
+    ceiling = set_ceiling(P, prop.role("goal"), centre)
+    floor = boundary_floor(P, prop.role("final"), centre)
+    if ceiling is None or floor is None or not 0 < ceiling * LEVEL_CUSHION < floor:
+        return None
+    level = Fraction(f"{ceiling * LEVEL_CUSHION:.3g}")
+    if not _decreases(plan, field, shape, level, discrete, rng):
+        return None
+    return E.add(_quadratic(shape, plan.states), E.Num(-level))
 
 
 def _reaching(plan: Plan, field, shape, level: Fraction, discrete: bool, rng):
