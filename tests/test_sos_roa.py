@@ -193,16 +193,18 @@ def test_the_multiplier_is_scaled_by_the_decay_and_the_size_of_i():
     """2α / r^2: the reversed Van der Pol's linearisation decays at α = 1/2 and I's box
     reaches 1.4 on each axis, so r^2 = 2 * 1.4^2."""
     plan = compile_spec(fossil_dsl.load(WIDE_VAN_DER_POL))
-    scale = sos_roa._multiplier_scale(plan, None, None, discrete=False)
+    linear = sos_roa._closed_jacobian(plan, None, None)
+    scale = sos_roa._multiplier_scale(plan, linear, discrete=False)
     assert scale == pytest.approx(2 * 0.5 / (2 * 1.4 ** 2))
-    shapes = sos_roa._shapes(plan, None, None, discrete=False)
+    shapes = sos_roa._shapes(plan, linear, discrete=False)
     assert shapes[:2] == [(1, 0.0), (2, 0.0)]  # V falling on all of D is tried first
     assert {w for _, w in shapes[2:]} == {f * scale for f in sos_roa.MULTIPLIER_FACTORS}
 
 
 def test_an_unstable_system_gets_no_region_with_the_multiplier_either():
     plan = compile_spec(fossil_dsl.loads(UNSTABLE))
-    assert sos_roa._multiplier_scale(plan, None, None, discrete=False) is None
+    linear = sos_roa._closed_jacobian(plan, None, None)
+    assert sos_roa._multiplier_scale(plan, linear, discrete=False) is None
     outward = UNSTABLE.replace("x1' = x1 + x2", "x1' = -x1 + x2").replace(
         "x2' = x2 - x1^3", "x2' = -x2 + x1^2 + x2^3")
     # stable at 0, but (simulated) a trajectory from the ball of 0.95 leaves D

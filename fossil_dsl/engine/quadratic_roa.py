@@ -42,8 +42,9 @@ UNSAFE_SAMPLES = 2000  # of U within D (stable while avoid): V > β there
 FORMS = ("region of attraction", "stable while avoid")
 # and reach (while avoid) takes V = k (x^T P x - β): Ω lies in S, and outside G (round the
 # origin) V falls by at least γ once k is large enough
-REACH_FORMS = ("reach while avoid", "reach", "reach-avoid-remain")
 # and RAR's B = x^T P x - b: b just over its largest value on G, {B <= 0} inside F
+REMAIN_FORM = "reach-avoid-remain"
+REACH_FORMS = ("reach while avoid", "reach", REMAIN_FORM)
 REACH_MARGIN = 10.0  # k makes V fall by this many times γ at the slowest sample of Ω \ G
 
 
@@ -172,10 +173,16 @@ def _floats(shape) -> np.ndarray:
 def _level(plan: Plan, shape) -> Fraction | None:
     """β just over an upper bound of V on I, where Ω = {V <= β} lies inside D by the
     shapes' bounds (else None)."""
+    return _level_between(shape, plan.spec.property.role("initial"), plan.spec.domain)
+
+
+def _level_between(shape, inner, outer) -> Fraction | None:
+    """A level just over an upper bound of x^T P x on `inner` whose sublevel set lies
+    inside `outer` by the shapes' bounds (else None)."""
     from fossil_dsl.engine.quadratic_shapes import boundary_floor, set_ceiling
     P, centre = _floats(shape), np.zeros(len(shape))
-    ceiling = set_ceiling(P, plan.spec.property.role("initial"), centre)
-    floor = boundary_floor(P, plan.spec.domain, centre)
+    ceiling = set_ceiling(P, inner, centre)
+    floor = boundary_floor(P, outer, centre)
     if ceiling is None or floor is None or not 0 < ceiling * LEVEL_CUSHION < floor:
         return None
     return Fraction(f"{ceiling * LEVEL_CUSHION:.3g}")
@@ -229,7 +236,7 @@ def _inside(plan: Plan, region, points: np.ndarray) -> np.ndarray:
 def _reach_formulas(plan: Plan, field, shape, level: Fraction, discrete: bool, rng):
     """{"V": V} (and RAR's "B") from the shape, or None where either fails its samples."""
     V = _reaching(plan, field, shape, level, discrete, rng)
-    if V is None or plan.certificate.form != REACH_FORMS[2]:
+    if V is None or plan.certificate.form != REMAIN_FORM:
         return None if V is None else {"V": V}
     B = _remaining(plan, field, shape, discrete, rng)
     return None if B is None else {"V": V, "B": B}
@@ -239,15 +246,9 @@ def _remaining(plan: Plan, field, shape, discrete: bool, rng):
     """RAR's B = x^T P x - b, b just over its largest value on G, where {B <= 0} lies in F
     and x^T P x falls at the samples of that set (and, for a map, each step from it
     lands in D); else None."""
-    from fossil_dsl.engine.quadratic_shapes import boundary_floor, set_ceiling
-    prop, P = plan.spec.property, _floats(shape)
-    centre = np.zeros(len(P))
-    ceiling = set_ceiling(P, prop.role("goal"), centre)
-    floor = boundary_floor(P, prop.role("final"), centre)
-    if ceiling is None or floor is None or not 0 < ceiling * LEVEL_CUSHION < floor:
-        return None
-    level = Fraction(f"{ceiling * LEVEL_CUSHION:.3g}")
-    if not _decreases(plan, field, shape, level, discrete, rng):
+    prop = plan.spec.property
+    level = _level_between(shape, prop.role("goal"), prop.role("final"))
+    if level is None or not _decreases(plan, field, shape, level, discrete, rng):
         return None
     return E.add(_quadratic(shape, plan.states), E.Num(-level))
 

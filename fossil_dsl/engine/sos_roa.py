@@ -86,8 +86,9 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     discrete = plan.spec.time is TimeDomain.DISCRETE
     controllers = lqr_controllers(plan, operating, np.random.default_rng(plan.options.seed))
     for controller, gain in itertools.islice(controllers, CONTROLLERS):
-        for field, stand_in in _fields(plan, controller, gain, operating, discrete):
-            found = _first_v(plan, field, sets, gain, operating, discrete, deadline)
+        linear = _closed_jacobian(plan, gain, operating)
+        for field, stand_in in _fields(plan, controller, linear, discrete):
+            found = _first_v(plan, field, sets, linear, discrete, deadline)
             if found is not None:
                 V, half, margin = found
                 return ReachFinding({"V": V}, controller, gain, operating, 2 * half, margin,
@@ -96,10 +97,10 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     return None
 
 
-def _first_v(plan: Plan, field, sets, gain, operating, discrete: bool, deadline: float):
+def _first_v(plan: Plan, field, sets, linear, discrete: bool, deadline: float):
     """(V, its half-degree, margin) of the first program solved with a margin, or None."""
     too_large = None  # the smallest half-degree whose program is too large
-    for half, weight in _shapes(plan, gain, operating, discrete):
+    for half, weight in _shapes(plan, linear, discrete):
         if time.monotonic() > deadline:
             return None
         if too_large is not None and half >= too_large:
@@ -114,7 +115,16 @@ def _first_v(plan: Plan, field, sets, gain, operating, discrete: bool, deadline:
     return None
 
 
-def _fields(plan: Plan, controller, gain, operating, discrete: bool):
+def _closed_jacobian(plan: Plan, gain, operating) -> np.ndarray | None:
+    """The closed loop's Jacobian at the origin (A + B K), or None where it has none."""
+    found = jacobians(plan.spec, operating if plan.spec.inputs else None)
+    if found is None:
+        return None
+    A, B = found
+    return A if gain is None else A + B @ np.asarray(gain, dtype=float)
+
+
+def _fields(plan: Plan, controller, linear, discrete: bool):
     """(the closed loop in polynomial form, 0) where it has one; then, where that has
     function variables or is None, (a stand-in keeping the linear part, its degree)."""
     closed = [traversal.substitute(f, controller) for f in plan.spec.dynamics]
@@ -123,11 +133,8 @@ def _fields(plan: Plan, controller, gain, operating, discrete: bool):
         yield field, 0
         if not field.facts:
             return
-    found = jacobians(plan.spec, operating if plan.spec.inputs else None)
-    if found is None:
+    if linear is None:
         return
-    A, B = found
-    linear = A if gain is None else A + B @ np.asarray(gain, dtype=float)
     fitted = polynomial_field(closed, plan.states, plan.spec.domain,
                               MAP_STAND_IN_DEGREES if discrete else STAND_IN_DEGREES,
                               plan.options.seed, linear)
@@ -137,27 +144,24 @@ def _fields(plan: Plan, controller, gain, operating, discrete: bool):
             max(P.degree(p) for p in fitted)
 
 
-def _shapes(plan: Plan, gain, operating, discrete: bool):
+def _shapes(plan: Plan, linear, discrete: bool):
     """(half-degree, λ) in the order tried: V falling on all of D first, then with the
     multiplier λ|x|^2 where the linear closed loop decays and I is bounded."""
     shapes = [(half, 0.0) for half in HALF_DEGREES]
-    scale = _multiplier_scale(plan, gain, operating, discrete)
+    scale = _multiplier_scale(plan, linear, discrete)
     if scale:
         shapes += [(half, factor * scale) for half in MULTIPLIED_HALF_DEGREES
                    for factor in MULTIPLIER_FACTORS]
     return shapes
 
 
-def _multiplier_scale(plan: Plan, gain, operating, discrete: bool) -> float | None:
-    """2α / r^2 (for a map, (1 - ρ^2) / r^2, ρ the spectral radius), or None."""
-    found = jacobians(plan.spec, operating if plan.spec.inputs else None)
+def _multiplier_scale(plan: Plan, linear, discrete: bool) -> float | None:
+    """2α / r^2 (for a map, (1 - ρ^2) / r^2, ρ the spectral radius) for the closed loop's
+    Jacobian `linear`, or None."""
     box = plan.spec.property.role("initial").bounding_box()
-    if found is None or box is None:
+    if linear is None or box is None:
         return None
-    A, B = found
-    if gain is not None:
-        A = A + B @ np.asarray(gain, dtype=float)
-    eigenvalues = np.linalg.eigvals(A)
+    eigenvalues = np.linalg.eigvals(linear)
     decay = 1 - np.abs(eigenvalues).max() ** 2 if discrete else -2 * eigenvalues.real.max()
     radius = sum(max(float(lo) ** 2, float(hi) ** 2) for lo, hi in zip(*box))
     return float(decay / radius) if decay > 0 and radius > 0 else None

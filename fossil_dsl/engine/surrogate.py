@@ -59,8 +59,8 @@ def _fitted(f, states, points: np.ndarray, degrees, row=None) -> P.Polynomial | 
     if row is None:
         return _fit(points[:, used], values, used, len(states), degrees)
     n = len(states)
-    part = {tuple(int(i == k) for i in range(n)): _rounded(row[k]) for k in range(n)}
-    part = {m: c for m, c in part.items() if c}
+    part = {tuple(int(i == k) for i in range(n)): c for k in range(n)
+            if (c := _rounded(row[k]))}
     rest = _fit(points[:, used], values - points @ row, used, n, degrees, lowest=2)
     return None if rest is None else P.add(part, rest)
 

@@ -150,16 +150,9 @@ def _tanh_argument(node):
     read back as tanh, the re-checks get tanh's facts and enclosures rather than those
     of a quotient of exponentials (probe64/am04's decrease: no refutation, and Arb left
     12 boxes after 50 000 in 60 s)."""
-    if not (isinstance(node, list) and len(node) == 3 and node[0] == "/"):
+    try:
+        z = node[1][1][1][2]
+    except (IndexError, TypeError):
         return None
-    top, bottom = node[1], node[2]
-    if not (isinstance(top, list) and isinstance(bottom, list) and len(top) == 3
-            and len(bottom) == 3 and top[0] == "-" and bottom[0] == "+"
-            and top[2] == bottom[2] == "1.0" and top[1] == bottom[1]):
-        return None
-    power = top[1]
-    if isinstance(power, list) and len(power) == 2 and power[0] == "exp" \
-            and isinstance(power[1], list) and len(power[1]) == 3 \
-            and power[1][:2] == ["*", "2.0"]:
-        return power[1][2]
-    return None
+    twice = ["exp", ["*", "2.0", z]]
+    return z if node == ["/", ["-", twice, "1.0"], ["+", twice, "1.0"]] else None
