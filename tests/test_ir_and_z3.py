@@ -344,7 +344,8 @@ def test_a_z3_check_that_ignores_its_interrupt_is_left_behind(monkeypatch):
 
     started = time.monotonic()
     try:
-        assert z3_backend._check_with_deadline(Deaf(), Context(), 0.1) is None
+        answer = z3_backend._check_with_deadline(Deaf(), Context(), 0.1)
+        assert answer.status is Status.UNKNOWN and answer.reason == z3_backend.LEFT_BEHIND
     finally:
         release.set()
     assert time.monotonic() - started < 5 and Context.interrupts == 1
@@ -353,7 +354,8 @@ def test_a_z3_check_that_ignores_its_interrupt_is_left_behind(monkeypatch):
     release.clear()
     started = time.monotonic()
     try:
-        assert z3_backend._check_with_deadline(Deaf(), Context(), 60, stop) is None
+        answer = z3_backend._check_with_deadline(Deaf(), Context(), 60, stop)
+        assert answer.status is Status.UNKNOWN and answer.reason == z3_backend.LEFT_BEHIND
     finally:
         release.set()
     assert time.monotonic() - started < 5 and Context.interrupts == 2
@@ -378,3 +380,22 @@ def test_an_error_in_a_z3_check_reaches_the_caller_at_once():
     with pytest.raises(z3.Z3Exception, match="broken"):
         z3_backend._check_with_deadline(Failing(), Context(), 60)
     assert time.monotonic() - started < 2
+
+
+def test_a_z3_check_canceled_by_its_timeout_is_unknown_not_an_internal_error():
+    """Z3 may end an interrupted or timed-out check by raising "canceled" (bytes) instead
+    of answering unknown: the false probe f62 ended as "fossilc: internal error:
+    Z3Exception: b'canceled'" after 51 s of a 120 s run."""
+    import z3
+    from fossil_dsl.solvers import z3_backend
+
+    class Canceled:
+        def check(self):
+            raise z3.Z3Exception(b"canceled")
+
+    class Context:
+        def interrupt(self):
+            pass
+
+    answer = z3_backend._check_with_deadline(Canceled(), Context(), 60)
+    assert answer.status is Status.UNKNOWN and answer.reason == z3_backend.CANCELED

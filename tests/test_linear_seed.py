@@ -256,3 +256,47 @@ def test_a_kink_at_the_origin_has_no_linearisation():
     """-|x| has one-sided slopes -1 and 1 at 0: no Jacobian, no linear seed."""
     kink = ABS_DRAG.replace("- 0.5*w*abs(w) - 0.1*w", "- abs(w)")
     assert jacobians(fossil_dsl.loads(kink)) is None
+
+
+# probe65/ao09: eight leaky tanh neurons on a ring, I a ball of 0.9 in the box of 1. The
+# Lyapunov equation's P (A is not normal) gives no sublevel set between I and D; P = I does
+HOPFIELD_RING = (Path(__file__).resolve().parent.parent
+                 / "specs/probe65/ao09_tanh_network_chain_roa_8d.fsl").read_text()
+
+
+def test_the_ellipsoid_seed_exists_without_inputs():
+    """Without inputs the gain's bound g was weighed in the objective and bounded
+    nothing: the program was unbounded and no system without inputs had an ellipsoid."""
+    spec = fossil_dsl.loads(HOPFIELD_RING)
+    A, B = jacobians(spec)
+    found = ellipsoid(A, B, spec, discrete=False)
+    assert found is not None
+    P, K = found
+    assert K.shape == (0, 8)
+    assert np.linalg.eigvalsh(P).max() <= 1 / 0.81 + 1e-4  # the ball of 0.9 inside {V <= 1}
+    assert np.diag(np.linalg.inv(P)).max() < 1  # inside the box of 1
+    assert np.linalg.eigvalsh(A.T @ P + P @ A).max() < 0
+
+
+def test_a_tanh_ring_is_certified_by_the_ellipsoid_between_i_and_d():
+    result = fossil_dsl.synthesise(fossil_dsl.loads(HOPFIELD_RING), timeout=60)
+    assert result.certified, result.summary()
+    assert result.iterations == 1  # the quadratic itself, nothing learned
+
+
+def test_the_strongest_feasible_rate_is_offered_after_the_roomy_one():
+    """probe65/ao10 (a planar quadrotor): the listed rates give 0.1 (s within ROOM),
+    where V grows at samples; bisection towards 0.3 (infeasible) finds a faster decay."""
+    from fossil_dsl.engine.ellipsoid_seed import ellipsoids
+    from fossil_dsl.engine.linear import operating_point
+    spec = fossil_dsl.load(Path(__file__).resolve().parent.parent
+                           / "specs/probe65/ao10_planar_quadrotor_stable_ctrl_6d.fsl")
+    A, B = jacobians(spec, operating_point(spec))
+    first, second = itertools.islice(ellipsoids(A, B, spec, discrete=False), 2)
+
+    def decay(P, K):  # the largest a with d/dt x^T P x <= -2 a x^T P x
+        closed = A + B @ K
+        L = np.linalg.cholesky(P)
+        M = np.linalg.solve(L, (closed.T @ P + P @ closed)) @ np.linalg.inv(L).T
+        return -np.linalg.eigvalsh((M + M.T) / 2).max() / 2
+    assert decay(*second) > 1.4 * decay(*first) > 0.13

@@ -60,9 +60,12 @@ def test_a_pendulum_on_a_cart_gets_the_ellipsoid_between_i_and_d_and_its_gain():
 
 def test_false_regions_of_attraction_get_no_candidate():
     """Initial sets past a separatrix or an equilibrium, a Van der Pol initial set past
-    its cycle, and an unstable focus (f38): decrease fails on samples of every Ω."""
+    its cycle, and an unstable focus (f38): decrease fails on samples of every Ω. Since
+    systems without inputs have the ellipsoid between I and D too, also a chemostat's I
+    reaching its washout line (f79) and a map with an unstable fixed point (f81)."""
     for name in ("f04_vdp_big_init", "f16_init_past_separatrix", "f22_roa_past_equilibrium",
-                 "f34_kuramoto_splay_in_init", "f38_fitzhugh_nagumo_antidamped"):
+                 "f34_kuramoto_splay_in_init", "f38_fitzhugh_nagumo_antidamped",
+                 "f79_chemostat_washout_line_roa", "f81_ricker_delay_map_unstable_roa"):
         assert _candidates(ROOT / "specs" / "false" / f"{name}.fsl") == [], name
 
 

@@ -1,5 +1,5 @@
 """An ellipsoid between I and D that the linearised closed loop keeps, with its state
-feedback, as a seed for a region of attraction with a controller.
+feedback where there are inputs, as a seed for a region of attraction.
 
 With Q = P^-1 and Y = K Q (u = K x), the classical linear matrix inequalities
 
@@ -11,13 +11,16 @@ With Q = P^-1 and Y = K Q (u = K x), the classical linear matrix inequalities
     a^T Q a <= s b^2       (and away from an unsafe half-space {a^T x >= b}, b > 0)
     [[g, Y], [Y^T, Q]] >= 0  (|u| bounded on the ellipsoid, so the nonlinear terms stay small)
 
-are solved for the smallest s + w g (Clarabel, through solvers/sdp.py). Where s < 1, {V <= 1} holds I and
-lies inside D, and the LQR seeds' identity weights may not manage that (a cart-pole's LQR
-ellipsoid is flat in one direction: every sublevel set that holds I leaves D). Nothing
-here is trusted: the seed is checked on samples and verified like any candidate.
+are solved for the smallest s + w g (s alone without inputs; Clarabel, through
+solvers/sdp.py). Where s < 1, {V <= 1} holds I and lies inside D, and the LQR seeds'
+identity weights may not manage that (a cart-pole's LQR ellipsoid is flat in one
+direction: every sublevel set that holds I leaves D; a non-normal A's Lyapunov matrices
+are far from round). Nothing here is trusted: the seed is checked on samples and verified
+like any candidate.
 """
 from __future__ import annotations
 
+import functools
 import itertools
 
 import numpy as np
@@ -30,6 +33,10 @@ from fossil_dsl.solvers.sdp import Program
 # 60 s; with a = 1, dV/dt <= -1.8 V on the samples)
 DECAYS = (3.0, 1.0, 0.5, 0.3, 0.1)
 CONTRACTIONS = (0.7, 0.85, 0.95, 0.98)
+# only where none of those is feasible: linearisations that decay slowly (probe61/ag01, a
+# two-link arm under PD: nothing at 0.1, s = 0.4 at 0.03)
+SLOW_DECAYS = (0.03, 0.01)
+SLOW_CONTRACTIONS = (0.995,)
 # w: how much a small |u| counts against a small ellipsoid; the later ones where the
 # earlier candidates fail: tanh-saturated inputs need |u| where tanh(u) is nearly u
 # (probe58/ab04: |u| <= 1.6 on the first ellipsoid, V grows at samples, 0.8 on the
@@ -42,6 +49,7 @@ SECONDS = 5.0  # for the solver
 # ellipsoid filled 95 % of D's box, and the level chosen from samples fell below I's
 # corners: an iteration lost); else the feasible one with the smallest s
 ROOM = 0.8
+BISECTIONS = 3  # of the gap between the strongest feasible listed rate and the next
 
 
 def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool,
@@ -49,6 +57,29 @@ def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool,
     """(P, K) with u = K x for the strongest rate whose s is at most ROOM (else the
     weakest feasible one), or None where the sets are not boxes or balls round the
     origin's neighbourhood, or the inequalities are infeasible, or s >= 1."""
+    solve = _solver(A, B, spec, discrete, weight)
+    return None if solve is None else _strongest(solve, discrete)
+
+
+def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
+    """ellipsoid()'s (P, K) for each of GAIN_WEIGHTS (the first alone without inputs):
+    the later ones keep |u| smaller on the ellipsoid (a saturating tanh(u) near u); each
+    followed by the strongest feasible rate, found by bisection, where that is another
+    (the nonlinear terms need the larger margin: probe65/ao10, a planar quadrotor, has V
+    growing at samples of the ellipsoid at a = 0.1 and none at 0.15 or 0.2, where s is
+    over ROOM)."""
+    for weight in GAIN_WEIGHTS[:len(GAIN_WEIGHTS) if B.shape[1] else 1]:
+        solve = _solver(A, B, spec, discrete, weight)
+        found = None if solve is None else _strongest(solve, discrete)
+        if found is not None:
+            yield found
+            stronger = _strongest_feasible(solve, discrete)
+            if stronger is not None and not np.allclose(stronger[0], found[0]):
+                yield stronger
+
+
+def _solver(A, B, spec, discrete: bool, weight: float):
+    """rate -> (P, K, s) or None, for the spec's sets; None where they do not suit."""
     half_widths = _half_widths(spec.domain, len(A))
     initial = spec.property.role("initial")
     radius = _ball_radius(initial)
@@ -56,22 +87,19 @@ def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool,
     if half_widths is None or corners is None:
         return None
     planes = _unsafe_planes(spec)
-    return _strongest(lambda rate: _solve(A, B, half_widths, corners, radius, discrete,
-                                          rate, planes, weight), discrete)
-
-
-def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
-    """ellipsoid()'s (P, K) for each of GAIN_WEIGHTS (the first alone without inputs):
-    the later ones keep |u| smaller on the ellipsoid (a saturating tanh(u) near u)."""
-    for weight in GAIN_WEIGHTS[:len(GAIN_WEIGHTS) if B.shape[1] else 1]:
-        found = ellipsoid(A, B, spec, discrete, weight)
-        if found is not None:
-            yield found
+    # (cached: the strongest feasible rate's search goes over the listed rates again)
+    return functools.lru_cache(maxsize=None)(
+        lambda rate: _solve(A, B, half_widths, corners, radius, discrete, rate, planes,
+                            weight))
 
 
 def _strongest(solve, discrete: bool):
+    """(P, K) for the strongest listed rate whose s is at most ROOM, else the weakest
+    feasible one; the slow rates only where no listed one is feasible."""
     last = None
-    for rate in CONTRACTIONS if discrete else DECAYS:
+    for rate in _rates(discrete):
+        if last is not None and rate in (SLOW_CONTRACTIONS if discrete else SLOW_DECAYS):
+            break
         try:
             found = solve(rate)
         except (ValueError, np.linalg.LinAlgError):  # numerical trouble: no seed
@@ -80,6 +108,30 @@ def _strongest(solve, discrete: bool):
             return found[:2]
         last = found or last
     return None if last is None else last[:2]
+
+
+def _rates(discrete: bool) -> tuple:
+    return CONTRACTIONS + SLOW_CONTRACTIONS if discrete else DECAYS + SLOW_DECAYS
+
+
+def _strongest_feasible(solve, discrete: bool):
+    """(P, K) at the strongest rate with s < 1, to within BISECTIONS halvings of the gap
+    between the listed rates, or None."""
+    rates = _rates(discrete)
+    try:
+        first = next((i for i, rate in enumerate(rates) if solve(rate) is not None), None)
+        if first is None:
+            return None
+        feasible, found = rates[first], solve(rates[first])
+        infeasible = rates[first - 1] if first else None
+        for _ in range(BISECTIONS if infeasible is not None else 0):
+            middle = (feasible + infeasible) / 2
+            result = solve(middle)
+            feasible, infeasible, found = (middle, infeasible, result) if result \
+                else (feasible, middle, found)
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    return found[:2]
 
 
 def _half_widths(domain, n: int) -> np.ndarray | None:
@@ -167,11 +219,12 @@ def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float,
     for a, b in planes:  # a^T Q a - s b^2 <= 0
         lmi.at_most.append((_sum([_scaled(Q[i][j], a[i] * a[j]) for i in range(n)
                                   for j in range(n)] + [({s: -b ** 2}, 0.0)])[0], 0.0))
-    x = lmi.solve({s: 1.0, g: weight}, SECONDS)
+    # without inputs g bounds nothing: weighed, it would leave the program unbounded
+    x = lmi.solve({s: 1.0, g: weight} if m else {s: 1.0}, SECONDS)
     if x is None or x[s] >= 1:
         return None
     Qv = np.array([[_value(Q[i][j], x) for j in range(n)] for i in range(n)])
-    Yv = np.array([[_value(Y[l][j], x) for j in range(n)] for l in range(m)])
+    Yv = np.array([[_value(Y[l][j], x) for j in range(n)] for l in range(m)]).reshape(m, n)
     P = np.linalg.inv(Qv)
     return (P + P.T) / 2, Yv @ P, float(x[s])
 

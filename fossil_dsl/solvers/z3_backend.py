@@ -23,6 +23,7 @@ STOP_POLL = 0.02  # s between looks at whether to interrupt Z3
 KEYBOARD = "interrupted from keyboard"  # Z3's reason after Ctrl-C
 ABANDON_AFTER = 5.0  # s after its interrupt that a check still running is left behind
 LEFT_BEHIND = "Z3 did not stop when interrupted; its check was left behind"
+CANCELED = "Z3's check was canceled (its timeout or an interrupt)"
 
 
 class Z3Converter:
@@ -119,8 +120,8 @@ class Z3Backend:
         solver.add(term, *converter.side_conditions)
         approximate = bool(converter.side_conditions)
         result = _check_with_deadline(solver, context, timeout, stop)
-        if result is None:
-            return Answer(Status.UNKNOWN, reason=LEFT_BEHIND)
+        if isinstance(result, Answer):
+            return result
         if result == z3.unsat:
             return Answer(Status.UNSAT, approximate=approximate)
         if result == z3.sat:
@@ -142,8 +143,8 @@ def check_smtlib(text: str, timeout: float) -> Answer:
     except z3.Z3Exception as exc:
         return Answer(Status.UNKNOWN, reason=f"Z3 could not read the script: {exc}")
     result = _check_with_deadline(solver, context, timeout)
-    if result is None:
-        return Answer(Status.UNKNOWN, reason=LEFT_BEHIND)
+    if isinstance(result, Answer):
+        return result
     if result == z3.unsat:
         return Answer(Status.UNSAT)
     if result == z3.sat:
@@ -156,7 +157,11 @@ def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
     """solver.check() in a worker thread, interrupted once `stop` is set or once Z3
     overruns its own timeout (nlsat does not always look at the clock, e.g. on
     high-degree polynomials). A check still running ABANDON_AFTER s after its interrupt
-    is left behind (a daemon thread) and the answer is unknown: the run goes on."""
+    is left behind (a daemon thread) and the answer is unknown: the run goes on. So is
+    a check that Z3 ends by raising "canceled" rather than answering unknown (its own
+    timeout or our interrupt caught inside a tactic: probe f62's run ended with
+    "internal error: Z3Exception: b'canceled'" after 51 s). Returns Z3's result, or the
+    Answer for these two."""
     done, lock = threading.Event(), threading.Lock()
     found = {}
 
@@ -185,11 +190,13 @@ def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
                 interrupt()
                 interrupted = now
             elif interrupted is not None and now > interrupted + ABANDON_AFTER:
-                return None
+                return Answer(Status.UNKNOWN, reason=LEFT_BEHIND)
     except KeyboardInterrupt:  # Python's own handler ran: stop Z3 too
         interrupt()
         raise
     result = found["result"]
+    if isinstance(result, z3.Z3Exception) and _canceled(result):
+        return Answer(Status.UNKNOWN, reason=CANCELED)
     if isinstance(result, BaseException):
         raise result
     if result == z3.unknown and solver.reason_unknown() == KEYBOARD:
@@ -197,6 +204,11 @@ def _check_with_deadline(solver: z3.Solver, context: z3.Context, timeout: float,
         # thread, where the run stops with what it has
         _thread.interrupt_main()
     return result
+
+
+def _canceled(exc: z3.Z3Exception) -> bool:
+    value = exc.value
+    return (value.decode() if isinstance(value, bytes) else str(value)) == "canceled"
 
 
 def _to_fraction(value) -> Fraction:
