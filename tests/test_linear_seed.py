@@ -278,10 +278,15 @@ def test_the_ellipsoid_seed_exists_without_inputs():
     assert np.linalg.eigvalsh(A.T @ P + P @ A).max() < 0
 
 
-def test_a_tanh_ring_is_certified_by_the_ellipsoid_between_i_and_d():
+def test_a_tanh_ring_is_certified_by_the_ellipsoid_between_i_and_d(tmp_path):
+    from fossil_dsl.outputs.recheck import recheck
     result = fossil_dsl.synthesise(fossil_dsl.loads(HOPFIELD_RING), timeout=60)
     assert result.certified, result.summary()
     assert result.iterations == 1  # the quadratic itself, nothing learned
+    assert "ε-stability" not in result.kernel.guarantee
+    result.save(tmp_path / "ring")
+    checks = recheck(tmp_path / "ring", timeout=30)
+    assert checks and all(c.reproved for c in checks), checks
 
 
 def test_the_strongest_feasible_rate_is_offered_after_the_roomy_one():
