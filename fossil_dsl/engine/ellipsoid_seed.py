@@ -96,18 +96,19 @@ def _solver(A, B, spec, discrete: bool, weight: float):
 def _strongest(solve, discrete: bool):
     """(P, K) for the strongest listed rate whose s is at most ROOM, else the weakest
     feasible one; the slow rates only where no listed one is feasible."""
-    last = None
-    for rate in _rates(discrete):
-        if last is not None and rate in (SLOW_CONTRACTIONS if discrete else SLOW_DECAYS):
-            break
-        try:
-            found = solve(rate)
-        except (ValueError, np.linalg.LinAlgError):  # numerical trouble: no seed
-            return None
-        if found is not None and found[2] <= ROOM:
-            return found[:2]
-        last = found or last
-    return None if last is None else last[:2]
+    for rates in ((CONTRACTIONS, SLOW_CONTRACTIONS) if discrete else (DECAYS, SLOW_DECAYS)):
+        last = None
+        for rate in rates:
+            try:
+                found = solve(rate)
+            except (ValueError, np.linalg.LinAlgError):  # numerical trouble: no seed
+                return None
+            if found is not None and found[2] <= ROOM:
+                return found[:2]
+            last = found or last
+        if last is not None:
+            return last[:2]
+    return None
 
 
 def _rates(discrete: bool) -> tuple:
