@@ -96,7 +96,7 @@ def _solver(A, B, spec, discrete: bool, weight: float):
 def _strongest(solve, discrete: bool):
     """(P, K) for the strongest listed rate whose s is at most ROOM, else the weakest
     feasible one; the slow rates only where no listed one is feasible."""
-    for rates in ((CONTRACTIONS, SLOW_CONTRACTIONS) if discrete else (DECAYS, SLOW_DECAYS)):
+    for rates in _rate_lists(discrete):
         last = None
         for rate in rates:
             try:
@@ -111,14 +111,16 @@ def _strongest(solve, discrete: bool):
     return None
 
 
-def _rates(discrete: bool) -> tuple:
-    return CONTRACTIONS + SLOW_CONTRACTIONS if discrete else DECAYS + SLOW_DECAYS
+def _rate_lists(discrete: bool) -> tuple[tuple, tuple]:
+    """(the listed rates, the slow ones), strongest first."""
+    return (CONTRACTIONS, SLOW_CONTRACTIONS) if discrete else (DECAYS, SLOW_DECAYS)
 
 
 def _strongest_feasible(solve, discrete: bool):
     """(P, K) at the strongest rate with s < 1, to within BISECTIONS halvings of the gap
     between the listed rates, or None."""
-    rates = _rates(discrete)
+    listed, slow = _rate_lists(discrete)
+    rates = listed + slow
     try:
         first = next((i for i, rate in enumerate(rates) if solve(rate) is not None), None)
         if first is None:
