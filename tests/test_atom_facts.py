@@ -71,6 +71,33 @@ def test_every_fact_holds_at_every_point_of_its_range(func, ends, share):
         assert _not_refuted(fact, env), (func, low, high, a, L.formula_text(fact))
 
 
+@settings(max_examples=300, deadline=None)
+@given(func=st.sampled_from(("sin", "cos")), low=st.fractions(-7, 7, max_denominator=1000),
+       width=st.fractions(F(1, 10 ** 6), F(1, 2), max_denominator=10 ** 6),
+       share=st.fractions(0, 1, max_denominator=1000))
+def test_taylor_facts_hold_on_every_narrow_range(func, low, width, share):
+    high = low + width
+    facts, atom = _facts(func, low, high)
+    # away from 0 the narrow range gets the Taylor facts, with 0 inside the sector ones
+    assert any("^2" in L.formula_text(f) and atom in L.formula_text(f) for f in facts) \
+        or low < 0 < high
+    for a in (low, high, low + share * width):
+        env = _at(a, func, atom)
+        for fact in facts:
+            assert _not_refuted(fact, env), (func, low, high, a, L.formula_text(fact))
+
+
+def test_taylor_facts_are_tight_and_fail_off_the_function():
+    facts, atom = _facts("sin", F(2, 5), F(1, 2))
+    upper, lower = facts[-2:]  # (after t^2 <= 1)
+    # the band the facts leave sin a on [0.4, 0.5] is below 4e-4 wide, so a value 1e-3
+    # off the true sine at the middle is refuted by one of them
+    for offset in (F(1, 1000), F(-1, 1000)):
+        env = _at(F(9, 20), "sin", atom)
+        env[atom] = env[atom] + sympy.Rational(offset.numerator, offset.denominator)
+        assert not (_not_refuted(upper, env) and _not_refuted(lower, env))
+
+
 @pytest.mark.parametrize("func", FUNCTIONS)
 def test_universal_facts_hold_far_out(func):
     # no range known: only the facts that hold for every real argument

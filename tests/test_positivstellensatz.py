@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 from fossil_dsl.solvers import sos_refutation
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
+from fossil_dsl.solvers.evidence_json import refutation_from_json, refutation_json
 from fossil_dsl.solvers.positivstellensatz import (Refutation, SumOfSquares, positive_semidefinite,
-                                                  refutation_from_json, refutation_json,
                                                   refutation_problem)
 
 X, Y = E.Var("x"), E.Var("y")
@@ -306,3 +306,41 @@ def test_without_the_closure_program_the_cubic_query_is_not_refuted(monkeypatch)
     query = L.conjunction(L.Compare(">", X, E.Num(F(1))),
                           L.Compare(">=", E.neg(E.power(X, E.Num(F(3)))), E.ZERO))
     assert sos_refutation.refute(query, ("x",), time.monotonic() + 20) is None
+
+
+def _by_elimination(gram) -> bool:
+    """The reference: symmetric Gaussian elimination on fractions (no negative pivot,
+    a zero pivot only with a zero row), the check used before FLINT's polynomial."""
+    n = len(gram)
+    a = [[F(v) for v in row] for row in gram]
+    if any(a[i][j] != a[j][i] for i in range(n) for j in range(i)):
+        return False
+    for k in range(n):
+        if a[k][k] < 0 or (a[k][k] == 0 and any(a[k][k + 1:])):
+            return False
+        for i in range(k + 1, n):
+            if a[k][k] and a[i][k]:
+                ratio = a[i][k] / a[k][k]
+                a[i][k + 1:] = [x - ratio * y for x, y in zip(a[i][k + 1:], a[k][k + 1:])]
+    return True
+
+
+@settings(max_examples=300, deadline=None)
+@given(rows=st.lists(st.lists(st.fractions(-3, 3, max_denominator=7), min_size=5,
+                              max_size=5), min_size=1, max_size=7),
+       shift=st.fractions(-1, 1, max_denominator=10 ** 30), where=st.integers(0, 4))
+def test_the_characteristic_polynomial_agrees_with_elimination(rows, shift, where):
+    # A^T A (often of low rank: PSD with zero eigenvalues) moved by a tiny or large
+    # rational on one diagonal entry: on both sides of the PSD boundary
+    gram = [[sum(r[i] * r[j] for r in rows) for j in range(5)] for i in range(5)]
+    gram[where][where] += shift * shift * shift
+    assert positive_semidefinite(gram) == _by_elimination(gram)
+
+
+def test_the_smallest_negative_eigenvalue_is_seen():
+    # [[1, 1], [1, 1 - 1e-40]] has det -1e-40: indefinite; with + it is definite
+    tiny = F(1, 10 ** 40)
+    assert not positive_semidefinite([[F(1), F(1)], [F(1), 1 - tiny]])
+    assert positive_semidefinite([[F(1), F(1)], [F(1), 1 + tiny]])
+    assert positive_semidefinite([])
+    assert not positive_semidefinite([[F(1), F(0)], [F(0)]])  # not square

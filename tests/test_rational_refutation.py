@@ -16,8 +16,8 @@ from fossil_dsl.ir import rational as R
 from fossil_dsl.ir import traversal
 from fossil_dsl.kernel.obligations import Obligation
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES, discharge
-from fossil_dsl.solvers.positivstellensatz import (refutation_from_json, refutation_json,
-                                                  refutation_problem)
+from fossil_dsl.solvers.evidence_json import refutation_from_json, refutation_json
+from fossil_dsl.solvers.positivstellensatz import refutation_problem
 from fossil_dsl.solvers.sos_refutation import refute
 
 X, Y, Z = E.Var("x"), E.Var("y"), E.Var("z")

@@ -11,6 +11,7 @@ from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.api import Backend, Status
+from fossil_dsl.solvers.slab_split import refuted_in_slabs, slab_variable
 from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, refute
 
 # per solver query on a found candidate, where no refutation settles a condition: a
@@ -22,6 +23,9 @@ SOS_QUERY_SECONDS = 5.0
 # learning is the weaker alternative there (probe60/ad08, a tanh ring's RAR: the quartic
 # V's decrease took the interval procedure 6 s; at 5 s, learning then failed in 100 s)
 STAND_IN_QUERY_SECONDS = 15.0
+# for refutations slab by slab (solvers/slab_split.py), where they would settle what the
+# refutations leave: probe65/ao10's decrease, 10 slabs of its pitch at 5-7 s each
+SLAB_SECONDS = 80.0
 
 
 def budgets(finding, floor: float) -> tuple[float, float]:
@@ -104,10 +108,21 @@ def _refuted(plan: Plan, cegis: Cegis, deadline: float, atoms_limit: int) -> Ceg
     candidate = cegis.exact_candidate()
     claim = Claim(plan.spec, dict(candidate.formulas), dict(candidate.controller),
                   dict(candidate.levels), plan.origin_radius)
-    refutations = {}
+    refutations, unrefuted = {}, []
     for obligation in list_obligations(claim):
         found = refute(obligation.query, plan.states, deadline, atoms_limit)
         if found is not None:
+            refutations[obligation.name] = found
+        else:
+            unrefuted.append(obligation)
+    if all(slab_variable(o.query, plan.states) for o in unrefuted):
+        # what is left may be refuted slab by slab; only worth its time where that would
+        # settle every obligation the refutations leave
+        slabs_until = min(cegis.deadline, time.monotonic() + SLAB_SECONDS)
+        for obligation in unrefuted:
+            found = refuted_in_slabs(obligation.query, plan.states, slabs_until)
+            if found is None:
+                break
             refutations[obligation.name] = found
     verdicts = _settled(tuple(Verdict(c.name, Status.UNKNOWN, "no refutation found")
                               for c in plan.conditions), refutations)

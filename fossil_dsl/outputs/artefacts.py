@@ -10,7 +10,7 @@ from pathlib import Path
 
 from fossil_dsl.kernel.obligations import file_stem
 from fossil_dsl.solvers.ball_split import BallSplit, split_json
-from fossil_dsl.solvers.positivstellensatz import refutation_json
+from fossil_dsl.solvers.evidence_json import refutation_json
 from fossil_dsl.outputs import onnx_export
 from fossil_dsl.outputs.summary import summary_text
 

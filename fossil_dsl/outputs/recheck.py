@@ -25,7 +25,8 @@ from fossil_dsl.kernel import Claim, NoRule, list_obligations
 from fossil_dsl.kernel.export import script
 from fossil_dsl.kernel.obligations import file_stem
 from fossil_dsl.solvers.ball_split import pieces, split_from_json
-from fossil_dsl.solvers.positivstellensatz import refutation_from_json, refutation_problem
+from fossil_dsl.solvers.evidence_json import refutation_from_json
+from fossil_dsl.solvers.positivstellensatz import refutation_problem
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES, bisection_first
 from fossil_dsl.solvers import registry
 from fossil_dsl.solvers.api import Status

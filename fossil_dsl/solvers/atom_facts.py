@@ -24,6 +24,9 @@ Facts for |a| <= L, with the constants below rounded the safe way from arb's enc
 - cos (L <= 3): (1 - cos a)/a^2 decreases in |a|, so t <= 1 - c a^2, c = (1 - cos L)/L^2.
 - exp, for lo <= a <= hi: below the chord, t <= E(lo) + (a - lo)(E(hi) - E(lo))/(hi - lo)
   with E an upper bound of exp (convexity).
+- sin, cos, for a range at most 1/2 wide without 0 inside: within a rounded-up ε of
+  their quadratic Taylor polynomial at its middle (taylor_facts.py); these replace the
+  sector facts there.
 Other functions (log, sqrt, tan) become a variable with no fact; abs stays (solvers
 encode it). tests/test_atom_facts.py checks every fact at many points against sympy at 60 digits.
 """
@@ -39,6 +42,7 @@ from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
 from fossil_dsl.solvers.arb_box import (ellipsoids, quadratic_ellipsoids, sqrt_up,
                                         starting_box)
+from fossil_dsl.solvers.taylor_facts import narrow, taylor_facts
 
 ATOM_PREFIX = "@"  # not a spec identifier's first character: no clash with a state
 GRID = 10 ** 9  # constants are rounded (the safe way) to this many parts of one
@@ -68,6 +72,8 @@ def _minus_cube(a: E.Expr, share: Fraction) -> E.Expr:
 
 
 def _sin(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+    if narrow(reach):
+        return [_square_at_most(t, 1)] + taylor_facts("sin", a, t, reach)
     width = _width(reach)
     if width is not None and width <= SINE_RANGE:
         return [_square_at_most(t, 1), _between(t, a, _scaled(_sin_ratio(width), a))]
@@ -75,6 +81,8 @@ def _sin(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
 
 
 def _cos(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+    if narrow(reach):
+        return [_at_most(t, _n(1))] + taylor_facts("cos", a, t, reach)
     facts = [_at_most(_one_minus(Fraction(1, 2), a), t), _at_most(t, _n(1))]
     width = _width(reach)
     if width is not None and width <= SINE_RANGE:
@@ -189,6 +197,12 @@ def abstracted_terms(terms: Sequence[E.Expr], region: L.Formula, states: Sequenc
     if any(func not in FACTS for func, _ in table.names):
         return None
     return rewritten, _facts(table, _Ranges(region)), tuple(states) + tuple(table.names.values())
+
+
+def argument_range(query: L.Formula, argument: E.Expr) -> tuple[Fraction, Fraction] | None:
+    """Exact bounds of a polynomial argument wherever the query holds (from its
+    conjuncts, as for the facts), or None."""
+    return _Ranges(query).of(argument)
 
 
 def _facts(table: "_Table", ranges: "_Ranges") -> list[L.Formula]:

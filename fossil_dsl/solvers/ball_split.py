@@ -25,8 +25,8 @@ from typing import Sequence
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
-from fossil_dsl.solvers.positivstellensatz import (Evidence, conjuncts, refutation_from_json,
-                                                  refutation_json)
+from fossil_dsl.solvers.evidence_json import refutation_from_json, refutation_json
+from fossil_dsl.solvers.positivstellensatz import Evidence, conjuncts
 from fossil_dsl.solvers.sos_refutation import refute
 
 RADIUS_STEP = math.sqrt(2)  # between the radii tried
