@@ -33,6 +33,39 @@ def test_constants_fold_exactly():
     assert isinstance(E.apply("sqrt", num(2)), E.Apply)
 
 
+@settings(max_examples=200, deadline=None)
+@given(func=st.sampled_from(("sin", "cos", "tan")),
+       c=st.fractions(-5, 5, max_denominator=12))
+def test_rational_multiples_of_pi_fold_only_to_their_exact_values(func, c):
+    # sin(pi/6) = 1/2 exactly, so an operating angle pi/6 with power 2 sin(pi/6) = 1
+    # gives an equilibrium the checker can decide; sin(pi/4) = sqrt(2)/2 stays a function
+    folded = E.apply(func, E.mul(num(c), E.Pi()))
+    true = getattr(mpmath, func)(mpmath.mpf(c.numerator) / c.denominator * mpmath.pi)
+    if isinstance(folded, E.Num):
+        assert abs(mpmath.mpf(folded.value.numerator) / folded.value.denominator - true) \
+            < mpmath.mpf(10) ** -12
+    else:  # not folded: the value is irrational (or tan is undefined there)
+        ratio = c * 6
+        assert ratio.denominator != 1 or abs(true) not in (0, 0.5, 1)
+
+
+def test_the_operating_angle_pi_over_6_is_an_equilibrium():
+    assert E.apply("sin", E.mul(num(Fraction(1, 6)), E.Pi())) == num(Fraction(1, 2))
+    assert E.apply("cos", E.mul(num(Fraction(2, 3)), E.Pi())) == num(Fraction(-1, 2))
+    assert E.apply("tan", E.mul(num(Fraction(-1, 4)), E.Pi())) == num(-1)
+    assert isinstance(E.apply("tan", E.mul(num(Fraction(1, 2)), E.Pi())), E.Apply)
+    assert E.apply("sin", E.Pi()) == E.ZERO
+    text = """state x, w
+dynamics continuous {
+    x' = w
+    w' = 1 - 2*sin(x + pi/6) - 0.5*w
+}
+domain box([-1, -1], [1, 1])
+prove stable
+"""
+    assert loads(text).states == ("x", "w")  # checked: f(0) = 1 - 2 sin(pi/6) = 0
+
+
 @pytest.mark.parametrize("build, message", [
     (lambda: E.div(x, E.ZERO), "division by zero"),
     (lambda: E.power(num(10), num(100_000)), "too large"),

@@ -8,7 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from fossil_dsl.ir.functions import FUNCTIONS, DomainError
+from fossil_dsl.ir.functions import FUNCTIONS, DomainError, exact_at_pi_multiple
+from fossil_dsl.ir.hash_cache import hash_cached
 from fossil_dsl.ir.numbers import number_text
 
 _SUM, _PRODUCT, _UNARY, _POWER, _ATOM = range(5)  # binding, loosest first
@@ -57,25 +58,7 @@ class Pi(Expr):
 
 
 def _compound(cls):
-    """A frozen dataclass node whose hash is computed once: a network's expressions
-    share subtrees, and the generated hash walks the whole tree on every dictionary
-    lookup (f1_barr3: 6.4 million hash calls in one run). The cached value is not
-    pickled: string hashes differ between processes."""
-    cls = dataclass(frozen=True)(cls)
-    generated = cls.__hash__
-
-    def __hash__(self):
-        cached = self.__dict__.get("_hash")
-        if cached is None:
-            cached = generated(self)
-            object.__setattr__(self, "_hash", cached)
-        return cached
-
-    def __getstate__(self):
-        return {k: v for k, v in self.__dict__.items() if k != "_hash"}
-
-    cls.__hash__, cls.__getstate__ = __hash__, __getstate__
-    return cls
+    return hash_cached(dataclass(frozen=True)(cls))
 
 
 @_compound
@@ -257,7 +240,25 @@ def apply(func: str, arg: Expr) -> Expr:
             raise ExprError(str(error)) from None
         if value is not None:
             return Num(value)
+    multiple = _pi_multiple(arg)
+    if multiple is not None:
+        value = exact_at_pi_multiple(func, multiple)
+        if value is not None:
+            return Num(value)
     return Apply(func, arg)
+
+
+def _pi_multiple(arg: Expr) -> Fraction | None:
+    """c where the argument is pi, c * pi or -(c * pi) (c rational), else None."""
+    if isinstance(arg, Pi):
+        return Fraction(1)
+    if isinstance(arg, Neg):
+        inner = _pi_multiple(arg.operand)
+        return None if inner is None else -inner
+    if isinstance(arg, Mul) and len(arg.factors) == 2 \
+            and {type(f) for f in arg.factors} == {Num, Pi}:
+        return next(f.value for f in arg.factors if isinstance(f, Num))
+    return None
 
 
 # ---- the tree -----------------------------------------------------------------

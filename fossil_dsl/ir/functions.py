@@ -1,7 +1,8 @@
 """The functions of the language, and their exact values where those are rational.
 
-Folding only ever applies to a rational argument, so this table needs no expression
-types: `expr.apply` asks it for the value at a number.
+Folding only ever applies to a rational argument (or a rational multiple of pi, for sin,
+cos and tan), so this table needs no expression types: `expr.apply` asks it for the value
+at a number.
 """
 from __future__ import annotations
 
@@ -59,3 +60,23 @@ FUNCTIONS: Mapping[str, Function] = {f.name: f for f in (
     Function("atan", _at_zero(0)),
     Function("abs", abs, piecewise_linear=True),
 )}
+
+
+# sin(k pi / 6) for k = 0..11 where it is rational (Niven's theorem: sin of a rational
+# multiple of pi is rational only at 0, +-1/2, +-1; tan only at 0, +-1), else None
+_SINE_SIXTHS = (Fraction(0), Fraction(1, 2), None, Fraction(1), None, Fraction(1, 2),
+                Fraction(0), Fraction(-1, 2), None, Fraction(-1), None, Fraction(-1, 2))
+
+_TANGENT_QUARTERS = (Fraction(0), Fraction(1), None, Fraction(-1))
+
+
+def exact_at_pi_multiple(func: str, c: Fraction) -> Fraction | None:
+    """func(c pi) where it is rational (sin(pi/6) = 1/2: an operating angle of pi/6 then
+    makes 1 - 2 sin(pi/6) exactly 0), else None."""
+    if func == "tan":  # rational only at 0 and +-1 (k pi / 4; k pi / 2 is a pole)
+        return _TANGENT_QUARTERS[int(4 * c) % 4] if (4 * c).denominator == 1 else None
+    if func == "cos":
+        return exact_at_pi_multiple("sin", c + Fraction(1, 2))
+    if func != "sin" or (6 * c).denominator != 1:
+        return None
+    return _SINE_SIXTHS[int(6 * c) % 12]
