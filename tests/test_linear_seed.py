@@ -305,3 +305,32 @@ def test_the_strongest_feasible_rate_is_offered_after_the_roomy_one():
         M = np.linalg.solve(L, (closed.T @ P + P @ closed)) @ np.linalg.inv(L).T
         return -np.linalg.eigvalsh((M + M.T) / 2).max() / 2
     assert decay(*second) > 1.4 * decay(*first) > 0.13
+
+
+def test_the_ellipsoid_also_decays_for_the_jacobians_half_way_to_d(tmp_path):
+    """probe60/ae02 (a ducted fan, 6 states, sin and cos of its tilt): no ellipsoid of the
+    linearisation alone has V falling at every sample; asked to decay for the Jacobians
+    half way to D's faces as well, one does, and the run is certified (a timeout
+    before)."""
+    from fossil_dsl.engine.ellipsoid_seed import ellipsoids
+    from fossil_dsl.engine.linear import operating_point
+    from fossil_dsl.engine.quadratic_roa import _vertices
+    from fossil_dsl.outputs.recheck import recheck
+    spec = fossil_dsl.load(Path(__file__).resolve().parent.parent
+                           / "specs/probe60/ae02_ducted_fan_hover_roa_ctrl_6d.fsl")
+    operating = operating_point(spec)
+    A, B = jacobians(spec, operating)
+    vertices = _vertices(spec, operating)
+    assert len(vertices) == 2 * len(spec.states)
+    linear = POLYNOMIAL.replace(" + x0*x1", "").replace("x0^3", "x0")
+    assert not _vertices(fossil_dsl.loads(linear), np.zeros(0))  # one Jacobian: nothing
+    P, K = next(ellipsoids(A, B, spec, False, vertices))
+    for Ai, Bi in [(A, B), *vertices]:  # V = x^T P x falls for every vertex's loop
+        closed = Ai + Bi @ K
+        assert np.linalg.eigvalsh(closed.T @ P + P @ closed).max() < 0
+    result = fossil_dsl.synthesise(spec, timeout=120)
+    assert result.certified, result.summary()
+    assert result.iterations == 1
+    result.save(tmp_path / "fan")
+    checks = recheck(tmp_path / "fan", timeout=30)
+    assert checks and all(c.reproved for c in checks), checks

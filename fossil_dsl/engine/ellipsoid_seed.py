@@ -61,15 +61,16 @@ def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool,
     return None if solve is None else _strongest(solve, discrete)
 
 
-def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
+def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool, vertices=()):
     """ellipsoid()'s (P, K) for each of GAIN_WEIGHTS (the first alone without inputs):
     the later ones keep |u| smaller on the ellipsoid (a saturating tanh(u) near u); each
     followed by the strongest feasible rate, found by bisection, where that is another
     (the nonlinear terms need the larger margin: probe65/ao10, a planar quadrotor, has V
     growing at samples of the ellipsoid at a = 0.1 and none at 0.15 or 0.2, where s is
-    over ROOM)."""
+    over ROOM). `vertices`, pairs (A_i, B_i) of Jacobians elsewhere in D, ask the same
+    decay of each (a polytopic differential inclusion round the linearisation)."""
     for weight in GAIN_WEIGHTS[:len(GAIN_WEIGHTS) if B.shape[1] else 1]:
-        solve = _solver(A, B, spec, discrete, weight)
+        solve = _solver(A, B, spec, discrete, weight, tuple(vertices))
         found = None if solve is None else _strongest(solve, discrete)
         if found is not None:
             yield found
@@ -78,7 +79,7 @@ def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool):
                 yield stronger
 
 
-def _solver(A, B, spec, discrete: bool, weight: float):
+def _solver(A, B, spec, discrete: bool, weight: float, vertices=()):
     """rate -> (P, K, s) or None, for the spec's sets; None where they do not suit."""
     half_widths = _half_widths(spec.domain, len(A))
     initial = spec.property.role("initial")
@@ -90,7 +91,7 @@ def _solver(A, B, spec, discrete: bool, weight: float):
     # (cached: the strongest feasible rate's search goes over the listed rates again)
     return functools.lru_cache(maxsize=None)(
         lambda rate: _solve(A, B, half_widths, corners, radius, discrete, rate, planes,
-                            weight))
+                            weight, vertices))
 
 
 def _strongest(solve, discrete: bool):
@@ -193,22 +194,14 @@ def _corners(initial, n: int) -> np.ndarray | None:
 
 
 def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float,
-           planes=(), weight: float = GAIN_WEIGHTS[0]):
+           planes=(), weight: float = GAIN_WEIGHTS[0], vertices=()):
     n, m = B.shape
     lmi = _Inequalities(n)
     Q = lmi.symmetric(n)  # positive semidefinite
     Y = [[({lmi.scalar(): 1.0}, 0.0) for _ in range(n)] for _ in range(m)]
     s, g = lmi.scalar(), lmi.scalar()
-    # C = A Q + B Y, entry by entry, as linear forms
-    C = [[_sum([_scaled(Q[k][j], A[i, k]) for k in range(n)]
-               + [_scaled(Y[l][j], B[i, l]) for l in range(m)]) for j in range(n)]
-         for i in range(n)]
-    if discrete:
-        lmi.block(2 * n, lambda i, j: Q[i][j] if j < n else C[j - n][i] if i < n
-                  else _scaled(Q[i - n][j - n], rate ** 2))
-    else:
-        lmi.block(n, lambda i, j: _scaled(_sum([C[i][j], C[j][i],
-                                                _scaled(Q[i][j], 2 * rate)]), -1.0))
+    for Ai, Bi in ((A, B), *vertices):
+        _decay(lmi, Q, Y, Ai, Bi, discrete, rate)
     if radius:  # I is a ball round the origin: Q - r^2 I >= 0
         lmi.block(n, lambda i, j: _sum([Q[i][j], ({}, -radius ** 2 if i == j else 0.0)]))
     for p in corners:
@@ -230,6 +223,21 @@ def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float,
     Yv = np.array([[_value(Y[l][j], x) for j in range(n)] for l in range(m)]).reshape(m, n)
     P = np.linalg.inv(Qv)
     return (P + P.T) / 2, Yv @ P, float(x[s])
+
+
+def _decay(lmi, Q, Y, A, B, discrete: bool, rate: float) -> None:
+    """The block that makes V = x^T Q^-1 x decay at `rate` along x' = (A + B K) x."""
+    n, m = B.shape
+    # C = A Q + B Y, entry by entry, as linear forms
+    C = [[_sum([_scaled(Q[k][j], A[i, k]) for k in range(n)]
+               + [_scaled(Y[l][j], B[i, l]) for l in range(m)]) for j in range(n)]
+         for i in range(n)]
+    if discrete:
+        lmi.block(2 * n, lambda i, j: Q[i][j] if j < n else C[j - n][i] if i < n
+                  else _scaled(Q[i - n][j - n], rate ** 2))
+    else:
+        lmi.block(n, lambda i, j: _scaled(_sum([C[i][j], C[j][i],
+                                                _scaled(Q[i][j], 2 * rate)]), -1.0))
 
 
 class _Inequalities(Program):

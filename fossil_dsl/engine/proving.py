@@ -116,14 +116,14 @@ def _refuted(plan: Plan, cegis: Cegis, deadline: float, atoms_limit: int) -> Ceg
         else:
             unrefuted.append(obligation)
     if all(slab_variable(o.query, plan.states) for o in unrefuted):
-        # what is left may be refuted slab by slab; only worth its time where that would
-        # settle every obligation the refutations leave
+        # what is left may be refuted slab by slab; only worth its time where every
+        # obligation the refutations leave could be (what slabs leave, such as a
+        # divisor's being nonzero, goes to the solvers next)
         slabs_until = min(cegis.deadline, time.monotonic() + SLAB_SECONDS)
         for obligation in unrefuted:
             found = refuted_in_slabs(obligation.query, plan.states, slabs_until)
-            if found is None:
-                break
-            refutations[obligation.name] = found
+            if found is not None:
+                refutations[obligation.name] = found
     verdicts = _settled(tuple(Verdict(c.name, Status.UNKNOWN, "no refutation found")
                               for c in plan.conditions), refutations)
     certified = all(v.status is Status.UNSAT for v in verdicts)

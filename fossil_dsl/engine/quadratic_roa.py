@@ -16,6 +16,7 @@ halfway level). Nothing here is trusted: V and β are proved like any candidate.
 """
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass
@@ -37,6 +38,9 @@ WEIGHT_SPREAD = 1.0  # their entries 10^u, u uniform in [-spread, spread]
 INSIDE, SHELL = 4000, 2000  # samples of Ω and of its boundary {V = β}
 LEVEL_CUSHION = 1.01  # β over the largest V on I (an upper bound worked out for I's shape)
 SIGNIFICANT = 6  # digits kept of P's entries
+# the ellipsoid asked to decay for the Jacobians this far towards each face of D, too
+# (after the linearisation's own): where the nonlinearity is strong on the ellipsoid
+VERTEX_SHARE = 0.5
 UNSAFE_SAMPLES = 2000  # of U within D (stable while avoid): V > β there
 # stable while avoid takes B = V - β: Ω cannot be left, so it is a barrier where it misses U
 FORMS = ("region of attraction", "stable while avoid")
@@ -132,11 +136,32 @@ def _shapes(plan: Plan, A: np.ndarray, B: np.ndarray, operating: np.ndarray, rng
             for Q in _weightings(len(A), rng):
                 yield controller, gain, lyapunov_matrix(closed, discrete, Q)
         if index == 0:
-            for P, K in ellipsoids(A, B if spec.inputs else np.zeros((len(A), 0)), spec,
-                                   discrete):
+            inputs = B if spec.inputs else np.zeros((len(A), 0))
+            for P, K in itertools.chain(
+                    ellipsoids(A, inputs, spec, discrete),
+                    ellipsoids(A, inputs, spec, discrete, _vertices(spec, operating))):
                 controller, gain = exact_controller(spec, K, operating, plan.options.digits) \
                     if spec.inputs else ({}, None)
                 yield controller, gain, P
+
+
+def _vertices(spec, operating: np.ndarray):
+    """(A_i, B_i): the Jacobians at the points half way to D's faces along each axis
+    (none for a linear field, or where D is not a box)."""
+    from fossil_dsl.engine.linear import jacobians
+    box = spec.domain.bounding_box()
+    if box is None or all(traversal.is_polynomial(f) and traversal.degree(f) <= 1
+                          for f in spec.dynamics):
+        return []
+    found = []
+    for i, (low, high) in enumerate(zip(*box)):
+        for end in (low, high):
+            point = np.zeros(len(spec.states))
+            point[i] = VERTEX_SHARE * float(end)
+            pair = jacobians(spec, operating, point)
+            if pair is not None:
+                found.append(pair)
+    return found
 
 
 def _stable(A: np.ndarray, discrete: bool) -> bool:
