@@ -12,10 +12,15 @@ With Q = P^-1 and Y = K Q (u = K x), the classical linear matrix inequalities
     [[g, Y], [Y^T, Q]] >= 0  (|u| bounded on the ellipsoid, so the nonlinear terms stay small)
 
 are solved for the smallest s + w g (s alone without inputs; Clarabel, through
-solvers/sdp.py). Where s < 1, {V <= 1} holds I and lies inside D, and the LQR seeds'
-identity weights may not manage that (a cart-pole's LQR ellipsoid is flat in one
-direction: every sublevel set that holds I leaves D; a non-normal A's Lyapunov matrices
-are far from round). Nothing here is trusted: the seed is checked on samples and verified
+solvers/sdp.py). The decay may be asked of more pairs (A_i, B_i) as well, Jacobians at
+other points of D (quadratic_roa.py: half way to each face): V then falls for every
+loop of that polytopic inclusion, which keeps it falling where the nonlinearity bends
+the field away from its linearisation (probe60/ae02, a ducted fan: no ellipsoid of the
+linearisation alone had V falling at every sample; with the 12 Jacobians, one has).
+Where s < 1, {V <= 1} holds I and lies inside D, and the LQR seeds' identity weights
+may not manage that (a cart-pole's LQR ellipsoid is flat in one direction: every
+sublevel set that holds I leaves D; a non-normal A's Lyapunov matrices are far from
+round). Nothing here is trusted: the seed is checked on samples and verified
 like any candidate.
 """
 from __future__ import annotations

@@ -26,6 +26,7 @@ STAND_IN_QUERY_SECONDS = 15.0
 # for refutations slab by slab (solvers/slab_split.py), where they would settle what the
 # refutations leave: probe65/ao10's decrease, 10 slabs of its pitch at 5-7 s each
 SLAB_SECONDS = 80.0
+SLAB_SHARE = 0.5  # of the run's time left, at most (learning may still do it)
 
 
 def budgets(finding, floor: float) -> tuple[float, float]:
@@ -119,7 +120,8 @@ def _refuted(plan: Plan, cegis: Cegis, deadline: float, atoms_limit: int) -> Ceg
         # what is left may be refuted slab by slab; only worth its time where every
         # obligation the refutations leave could be (what slabs leave, such as a
         # divisor's being nonzero, goes to the solvers next)
-        slabs_until = min(cegis.deadline, time.monotonic() + SLAB_SECONDS)
+        now = time.monotonic()
+        slabs_until = now + min(SLAB_SECONDS, SLAB_SHARE * (cegis.deadline - now))
         for obligation in unrefuted:
             found = refuted_in_slabs(obligation.query, plan.states, slabs_until)
             if found is not None:

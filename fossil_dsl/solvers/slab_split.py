@@ -10,10 +10,12 @@ refutation of its own: the other five directions are settled by the program, not
 boxes.
 
 Slabs of width at most WIDEST are tried first, across the state's range from the query's
-own conjuncts; one without a refutation is halved, down to NARROWEST (then the split
-fails: the rest is not tried). The outermost slabs are open (v <= e_1, v >= e_K), so the
-pieces cover every point whatever the range; positivstellensatz.SlabSplit checks the
-refutations, exactly, against pieces it computes itself from the query and the edges.
+own conjuncts, the outermost first; one without a refutation is halved, down to NARROWEST
+(then the split fails: the rest is not tried), and the split is given up as soon as the
+slabs left would not be done by the deadline at the pace so far. The outermost slabs are
+open (v <= e_1, v >= e_K), so the pieces cover every point whatever the range;
+positivstellensatz.SlabSplit checks the refutations, exactly, against pieces it computes
+itself from the query and the edges.
 """
 from __future__ import annotations
 
@@ -29,7 +31,7 @@ from fossil_dsl.solvers.positivstellensatz import SlabSplit, slab
 from fossil_dsl.solvers.sos_refutation import refute
 
 WIDEST = Fraction(1, 5)  # the slabs first tried are at most this wide
-NARROWEST = Fraction(1, 40)  # a slab this narrow without a refutation: the split fails
+NARROWEST = Fraction(1, 20)  # a slab this narrow without a refutation: the split fails
 GRID = 1000  # edges are multiples of 1/GRID
 ATOMS_LIMIT = 12_000  # the largest program for a slab (ao10's: up to 8 000 variables)
 FROM_STATES = 4  # below this, bisection refutes such queries well enough
@@ -61,24 +63,37 @@ def refuted_in_slabs(query: L.Formula, states: Sequence[str], deadline: float,
     count = max(1, math.ceil((high - low) / WIDEST))
     edges = sorted({_on_grid(low + (high - low) * k / count) for k in range(1, count)})
     ends = [None, *edges, None]
-    pending = list(zip(ends, ends[1:]))[::-1]  # a stack: the lowest slab on top
-    found: list = []
+    # the outermost slabs first, where the field bends most from its linearisation and
+    # a refutation is likeliest to fail (then nothing more is tried)
+    pending = sorted(zip(ends, ends[1:]), key=lambda ends_: _distance(ends_, low, high))
+    found: dict = {}
+    started, tried = time.monotonic(), 0
     while pending:
-        if time.monotonic() > deadline:
-            return None
+        now = time.monotonic()
+        if now > deadline or (tried and (now - started) / tried * len(pending) > deadline - now):
+            return None  # (at the pace so far, the slabs left would not be done in time)
         lower, upper = pending.pop()
+        tried += 1
         refutation = refute(slab(query, variable, lower, upper), states, deadline,
                             atoms_limit)
         if refutation is not None:
-            found.append((lower, upper, refutation))
+            found[lower] = (upper, refutation)
             continue
         bottom, top = low if lower is None else lower, high if upper is None else upper
         middle = _on_grid((bottom + top) / 2)
         if top - bottom < 2 * NARROWEST or not bottom < middle < top:
             return None
         pending += [(middle, upper), (lower, middle)]
-    return SlabSplit(variable, tuple(upper for _, upper, _ in found[:-1]),
-                     tuple(refutation for _, _, refutation in found))
+    ordered = [found[lower] for lower in sorted(found, key=lambda e: -math.inf if e is None
+                                                else e)]
+    return SlabSplit(variable, tuple(upper for upper, _ in ordered[:-1]),
+                     tuple(refutation for _, refutation in ordered))
+
+
+def _distance(ends, low: Fraction, high: Fraction) -> Fraction:
+    """How far the slab's middle lies from the origin (the open ends at the range's)."""
+    lower, upper = ends
+    return abs((low if lower is None else lower) + (high if upper is None else upper))
 
 
 def _on_grid(value: Fraction) -> Fraction:
