@@ -118,7 +118,7 @@ SHIFTED = """\
 state x0, x1
 dynamics continuous {
     x0' = x1
-    x1' = -0.5*x1 - SIGN*(sin(x0 + pi/3) - sin(pi/3))
+    x1' = -0.5*x1 - SIGN*(sin(x0 + pi/4) - sin(pi/4))
 }
 domain box([-0.5, -0.5], [0.5, 0.5])
 prove stable
@@ -126,8 +126,9 @@ prove stable
 
 
 def test_a_hessian_with_irrational_entries_is_stated_exactly_and_proved_soundly():
-    """The change of V along x1' = ... - sin(x0 + pi/3) has cos(pi/3) in its Hessian at
-    0: the lemma states it as the closed term, and only a sound enclosure proves it."""
+    """The change of V along x1' = ... - sin(x0 + pi/4) has cos(pi/4) in its Hessian at
+    0: the lemma states it as the closed term, and only a sound enclosure proves it.
+    (pi/4, not pi/3: cos(pi/3) folds to the rational 1/2.)"""
     stable = SHIFTED.replace("SIGN", "1")
     result = fossil_dsl.synthesise(fossil_dsl.loads(candidate(
         stable, "2*x0^2 + 2*x0*x1 + 3*x1^2")), verifier="interval", timeout=120)
