@@ -116,6 +116,7 @@ def test_the_planar_quadrotor_is_certified_through_slabs_and_rechecked(tmp_path)
     assert result.certified
     evidence = result.refutations["condition:decrease"]
     assert isinstance(evidence, SlabSplit) and evidence.variable == "th"
+    assert f"refuted in {len(evidence.slabs)} slabs across th" in result.summary()
     result.save(tmp_path)
     checks = recheck(tmp_path)
     assert all(check.reproved for check in checks)

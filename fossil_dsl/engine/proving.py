@@ -11,6 +11,7 @@ from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.api import Backend, Status
+from fossil_dsl.solvers.positivstellensatz import SlabSplit
 from fossil_dsl.solvers.slab_split import refuted_in_slabs, slab_variable
 from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, refute
 
@@ -150,7 +151,14 @@ def _merged(outcome: CegisOutcome, refutations: dict) -> CegisOutcome:
 def _settled(verdicts, refutations: dict) -> tuple[Verdict, ...]:
     """Each condition not proved yet that a refutation of the kernel's obligation for it
     settles, as proved by it."""
-    return tuple(replace(v, status=Status.UNSAT, solver=SUM_OF_SQUARES, reason="",
-                         counterexample=None)
+    return tuple(replace(v, status=Status.UNSAT, solver=SUM_OF_SQUARES, counterexample=None,
+                         reason=_how(refutations[f"condition:{v.condition}"]))
                  if v.status is not Status.UNSAT and f"condition:{v.condition}" in refutations
                  else v for v in verdicts)
+
+
+def _how(refutation) -> str:
+    """What the summary says of a refutation beside the procedure's name."""
+    if isinstance(refutation, SlabSplit):
+        return f"refuted in {len(refutation.slabs)} slabs across {refutation.variable}"
+    return ""
