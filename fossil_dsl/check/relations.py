@@ -53,7 +53,7 @@ class Subject:
 
 
 def _linear(formula: L.Formula) -> bool:
-    return all(traversal.is_polynomial(side) and traversal.degree(side) <= 1
+    return all(traversal.is_affine(side)
                for c in L.comparisons(formula) for side in (c.left, c.right))
 
 

@@ -150,8 +150,7 @@ def _vertices(spec, operating: np.ndarray):
     (none for a linear field, or where D is not a box)."""
     from fossil_dsl.engine.linear import jacobians
     box = spec.domain.bounding_box()
-    if box is None or all(traversal.is_polynomial(f) and traversal.degree(f) <= 1
-                          for f in spec.dynamics):
+    if box is None or all(map(traversal.is_affine, spec.dynamics)):
         return []
     found = []
     for i, (low, high) in enumerate(zip(*box)):

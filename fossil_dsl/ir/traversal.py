@@ -65,6 +65,11 @@ def is_polynomial(expr: Expr) -> bool:
     return True
 
 
+def is_affine(expr: Expr) -> bool:
+    """A polynomial of degree at most 1."""
+    return is_polynomial(expr) and degree(expr) <= 1
+
+
 def is_arithmetic(expr: Expr) -> bool:
     """Decidable by nonlinear real arithmetic: polynomials, division, integer powers, abs."""
     for node in walk(expr):

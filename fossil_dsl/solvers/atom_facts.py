@@ -33,19 +33,18 @@ encode it). tests/test_atom_facts.py checks every fact at many points against sy
 from __future__ import annotations
 
 from fractions import Fraction
-from math import ceil, floor
 from typing import Sequence
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
+from fossil_dsl.solvers.arb_rounding import arb, lower, upper
 from fossil_dsl.solvers.arb_box import (ellipsoids, quadratic_ellipsoids, sqrt_up,
                                         starting_box)
 from fossil_dsl.solvers.taylor_facts import narrow, taylor_facts
 
 ATOM_PREFIX = "@"  # not a spec identifier's first character: no clash with a state
-GRID = 10 ** 9  # constants are rounded (the safe way) to this many parts of one
 SINE_RANGE = 3  # below pi: sin(a)/a and (1 - cos a)/a^2 still decrease
 
 
@@ -86,7 +85,7 @@ def _cos(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
     facts = [_at_most(_one_minus(Fraction(1, 2), a), t), _at_most(t, _n(1))]
     width = _width(reach)
     if width is not None and width <= SINE_RANGE:
-        facts.append(_at_most(t, _one_minus(_lower(_cosine_ratio(width)), a)))
+        facts.append(_at_most(t, _one_minus(lower(_cosine_ratio(width)), a)))
     return facts
 
 
@@ -126,7 +125,7 @@ def _square_at_most(t: E.Expr, bound) -> L.Formula:
 
 def _scaled(ratio, a: E.Expr) -> E.Expr:
     """k a for a rational k just below the arb ratio."""
-    return E.mul(_n(_lower(ratio)), a)
+    return E.mul(_n(lower(ratio)), a)
 
 
 def _one_minus(share: Fraction, a: E.Expr) -> E.Expr:
@@ -134,36 +133,21 @@ def _one_minus(share: Fraction, a: E.Expr) -> E.Expr:
 
 
 def _chord(a: E.Expr, lo: Fraction, hi: Fraction) -> E.Expr:
-    at_lo, at_hi = _upper(_arb(lo).exp()), _upper(_arb(hi).exp())
+    at_lo, at_hi = upper(arb(lo).exp()), upper(arb(hi).exp())
     slope = (at_hi - at_lo) / (hi - lo)
     return E.add(_n(at_lo), E.mul(_n(slope), E.add(a, _n(-lo))))
 
 
-def _arb(value: Fraction):
-    import flint
-    return flint.arb(value.numerator) / value.denominator
-
-
 def _sin_ratio(width: Fraction):
-    return _arb(width).sin() / _arb(width)
+    return arb(width).sin() / arb(width)
 
 
 def _cosine_ratio(width: Fraction):
-    return (1 - _arb(width).cos()) / _arb(width) ** 2
+    return (1 - arb(width).cos()) / arb(width) ** 2
 
 
 def _ratio(func: str, width: Fraction):
-    return getattr(_arb(width), func)() / _arb(width)
-
-
-def _lower(value) -> Fraction:
-    mantissa, exponent = value.lower().mid().man_exp()
-    return Fraction(floor(Fraction(int(mantissa)) * Fraction(2) ** int(exponent) * GRID), GRID)
-
-
-def _upper(value) -> Fraction:
-    mantissa, exponent = value.upper().mid().man_exp()
-    return Fraction(ceil(Fraction(int(mantissa)) * Fraction(2) ** int(exponent) * GRID), GRID)
+    return getattr(arb(width), func)() / arb(width)
 
 
 def replaceable(node: E.Expr) -> bool:

@@ -20,13 +20,12 @@ sector facts: they vanish with a, as conditions near the origin need.
 from __future__ import annotations
 
 from fractions import Fraction
-from math import ceil
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
+from fossil_dsl.solvers.arb_rounding import GRID, arb, nearest, upper
 
 NARROW = Fraction(1, 2)  # the widest range these facts are given for
-GRID = 10 ** 9  # constants are rational with this denominator
 
 
 def narrow(reach) -> bool:
@@ -40,9 +39,10 @@ def taylor_facts(func: str, a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
     lo, hi = reach
     middle = Fraction(round((lo + hi) / 2 * GRID), GRID)
     half = max(hi - middle, middle - lo)
-    sine, cosine = _arb(middle).sin(), _arb(middle).cos()
-    s, k = _nearest(sine), _nearest(cosine)
-    sine_error, cosine_error = _gap(sine, s), _gap(cosine, k)
+    sine, cosine = arb(middle).sin(), arb(middle).cos()
+    s, k = nearest(sine), nearest(cosine)
+    # upper bounds of |true value - rational| (the balls hold the true values)
+    sine_error, cosine_error = upper(abs(sine - arb(s))), upper(abs(cosine - arb(k)))
     if func == "sin":
         coefficients = (s, k, -s / 2)
         value_error, slope_error = sine_error, cosine_error
@@ -50,30 +50,9 @@ def taylor_facts(func: str, a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
         coefficients = (k, -s, -k / 2)
         value_error, slope_error = cosine_error, sine_error
     error = value_error * (1 + half * half / 2) + slope_error * half \
-        + _round_up(_arb(half) ** 3 / 6)
+        + upper(arb(half) ** 3 / 6)
     shift = E.add(a, E.Num(-middle))
     taylor = E.add(E.Num(coefficients[0]), E.mul(E.Num(coefficients[1]), shift),
                    E.mul(E.Num(coefficients[2]), E.power(shift, E.Num(Fraction(2)))))
     return [L.Compare("<=", t, E.add(taylor, E.Num(error))),
             L.Compare("<=", E.add(taylor, E.Num(-error)), t)]
-
-
-def _arb(value: Fraction):
-    import flint
-    return flint.arb(value.numerator) / value.denominator
-
-
-def _nearest(ball) -> Fraction:
-    """A rational on the grid near the ball's middle."""
-    mantissa, exponent = ball.mid().man_exp()
-    return Fraction(round(Fraction(int(mantissa)) * Fraction(2) ** int(exponent) * GRID), GRID)
-
-
-def _gap(ball, rational: Fraction) -> Fraction:
-    """An upper bound of |true value - rational| (the ball holds the true value)."""
-    return _round_up(abs(ball - _arb(rational)))
-
-
-def _round_up(ball) -> Fraction:
-    mantissa, exponent = ball.upper().mid().man_exp()
-    return Fraction(ceil(Fraction(int(mantissa)) * Fraction(2) ** int(exponent) * GRID), GRID)
