@@ -27,7 +27,8 @@ from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.gram_rounding import decimal
-from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES, opposite_pairs
+from fossil_dsl.solvers.refutation_plan import opposite_pairs
+from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.plan.certificates.roa import ROA_FORMS
 

@@ -33,6 +33,8 @@ from fossil_dsl.solvers.positivstellensatz import (CaseSplit, Evidence, Power, P
                                                   Refutation, cases, comparisons, conjuncts,
                                                   disjunction_branches, polynomial_form,
                                                   refutation_problem)
+from fossil_dsl.solvers.refutation_plan import (independent_parts, opposite_bounds, restricted,
+                                               variants, widened)
 from fossil_dsl.solvers.sdp import Program
 
 MAX_VARIABLES = 30_000  # beyond this a program is not tried (time, memory)
@@ -114,36 +116,46 @@ def _refuted_conjunction(query: L.Formula, states, deadline: float,
         atoms = comparisons(query, states)
     except ValueError:
         return None
+    for part, variables in independent_parts(atoms):
+        variables = variables or tuple(range(len(states)))  # only constants: keep them all
+        kept = restricted([atoms[i] for i in part], variables)
+        for found in _candidates(kept, len(variables), abstract, deadline, atoms_limit):
+            found = widened(found, part, len(atoms), variables, len(states))
+            if refutation_problem(found, query, states) is None:
+                return found
+    return None
+
+
+def _candidates(atoms, n: int, abstract: bool, deadline: float, atoms_limit: int):
+    """The rounded solutions of the programs tried for these atoms, in order."""
     powers, limit = ((1,), atoms_limit) if abstract else (POWERS, MAX_VARIABLES)
     bounds = None if abstract else opposite_bounds(atoms)
-    lows = (0, 1, 2) if not abstract and _origin_left_out(atoms, len(states)) else (1, 2, 0)
-    for power, low, pairs, raised, closed in _variants(
-            powers, bounds, _raise_worthwhile(abstract, states, atoms), lows,
+    lows = (0, 1, 2) if not abstract and _origin_left_out(atoms, n) else (1, 2, 0)
+    for power, low, pairs, raised, closed in variants(
+            powers, bounds, _raise_worthwhile(abstract, n, atoms), lows,
             _closure_worthwhile(atoms)):
-        if time.monotonic() > deadline or _smallest_size(len(states), atoms, power) > limit:
-            return None
+        if time.monotonic() > deadline or _smallest_size(n, atoms, power) > limit:
+            return
         try:
-            program = _RefutationProgram(len(states), atoms, low, power, pairs, raised,
-                                         closed)
+            program = _RefutationProgram(n, atoms, low, power, pairs, raised, closed)
         except _Hopeless:
             continue
         if program.count > limit:
             if pairs:  # the products made it too large; the next program may not be
                 continue
-            return None
+            return
         x = program.solve({program.interior: -1.0}, deadline - time.monotonic())
         found = program.exact(x) if x is not None else None
-        if found is not None and refutation_problem(found, query, states) is None:
-            return found
-    return None
+        if found is not None:
+            yield found
 
 
-def _raise_worthwhile(abstract: bool, states, atoms) -> bool:
+def _raise_worthwhile(abstract: bool, n: int, atoms) -> bool:
     """Whether the programs with raised multipliers are tried: polynomial queries of
     degree RAISED_FROM_DEGREE or more whose raised s0 stays small."""
     degree = max((P.degree(h) for h, _ in atoms), default=0)
     return (not abstract and degree >= RAISED_FROM_DEGREE
-            and _smallest_size(len(states), atoms, POWERS[0], 1) <= RAISED_MAX_ENTRIES)
+            and _smallest_size(n, atoms, POWERS[0], 1) <= RAISED_MAX_ENTRIES)
 
 
 def _origin_left_out(atoms, n: int) -> bool:
@@ -163,56 +175,6 @@ def _closure_worthwhile(atoms) -> bool:
     were read as h >= 0 (its degree is at least 2 below the query's)."""
     top = max(2, max(P.degree(h) for h, _ in atoms))
     return any(strict and 2 * ((top + 1) // 2) - P.degree(h) >= 2 for h, strict in atoms)
-
-
-def _variants(powers, pairs, raise_too: bool, lows=(1, 2, 0), closure: bool = False):
-    """(power, low, products, raised, closed) of the programs tried, in order.
-
-    Each power with each low of `lows` in turn (1, 2, 0; 0 first where the origin is left
-    out), and the first power again with the box's products, if there are any (not in
-    every variant: a 3-state map's unrefutable query took 8.4 s instead of 3.3 s), and
-    none for abstracted queries, whose facts' bounds would make their programs larger.
-    After the first power's programs, where it differs (`closure`), the program for the
-    query's closure (`closed`): every comparison read as h >= 0, with sums of squares as
-    multipliers, and the constant 1 > 0, a proof that even the closure is empty. A strict
-    comparison such as "outside the goal ball", |x|^2 - r^2 > 0, otherwise has a constant
-    multiplier only, where the decrease it guards may need a polynomial one (probe59/ac15:
-    a map's quartic V, found with a margin of 0.28 on D outside G, had no other
-    refutation of its decrease).
-    Last, where they are small, the programs with low 0 with multipliers of one degree
-    more (`raised`): a decrease on a sublevel set {V <= β} of a degree-6 V (probe48/c02,
-    tight against the basin) needs a multiplier of β - V of degree 4, not 2."""
-    found = []
-    for power, low in ((m, low) for m in powers for low in lows):
-        found.append((power, low, (), 0, False))
-        if pairs and power == powers[0] and low != 2:
-            found.append((power, low, pairs, 0, False))
-        if closure and power == powers[0] and low == lows[-1]:
-            found.append((power, 0, pairs or (), 0, True))
-    if raise_too:
-        found += [(powers[0], 0, products, 1, False)
-                  for products in ((pairs,) if pairs else ()) + ((),)]
-    return found
-
-
-def opposite_bounds(atoms) -> list[tuple[int, int]] | None:
-    """The pairs of non-strict comparisons among `opposite_pairs`, or None where there
-    are none. Without their products a box's multipliers of low degree cannot see that
-    it is bounded: a degree-4 V for a 4-state cubic system (probe44/y02), found by a
-    program with them, had no refutation of its decrease without them (6 programs,
-    4.5 s); with them the first program (a third larger) is one."""
-    pairs = [(i, k) for i, k in opposite_pairs([h for h, _ in atoms])
-             if not atoms[i][1] and not atoms[k][1]]
-    return pairs or None
-
-
-def opposite_pairs(polynomials) -> list[tuple[int, int]]:
-    """The index pairs of linear polynomials that bound one expression from both sides
-    (l <= x_i and x_i <= u as x_i - l >= 0 and u - x_i >= 0: their sum is a constant, and
-    their product (x_i - l)(u - x_i) >= 0)."""
-    linear = [i for i, h in enumerate(polynomials) if P.degree(h) == 1]
-    return [(i, k) for a, i in enumerate(linear) for k in linear[a + 1:]
-            if P.degree(P.add(polynomials[i], polynomials[k])) < 1]
 
 
 def _least_abstracted_size(query: L.Formula, states) -> int:
