@@ -440,3 +440,15 @@ def test_a_map_is_steered_by_its_step_not_by_a_jump_across_the_target():
     learner.field = lambda points: list((points + 50 * (centre - points)).unbind(1))
     assert halfway == pytest.approx(-1.0)
     assert float(learner.control_loss()) == pytest.approx(halfway)
+
+
+def test_a_stand_in_programs_function_gets_a_share_of_the_time_left_per_query():
+    """probe64/am05's degree-4 V needed 28 s of the interval procedure for its decrease:
+    a stand-in's function gets 15 s per query, or 0.3 of the time left if more."""
+    from types import SimpleNamespace
+    from fossil_dsl.engine.proving import budgets
+    finding = SimpleNamespace(stand_in=True, seconds=0.5)
+    assert budgets(finding, 5.0, time.monotonic() + 100)[1] == pytest.approx(30, abs=0.1)
+    assert budgets(finding, 5.0, time.monotonic() + 10)[1] == 15.0
+    exact = SimpleNamespace(stand_in=False, seconds=4.0)
+    assert budgets(exact, 5.0, time.monotonic() + 100) == (8.0, 5.0)

@@ -3,6 +3,9 @@ kernel's Taylor lemma (kernel/local.py): asymptotic stability instead of ε-stab
 and only where every hypothesis of the lemma is proved."""
 from fractions import Fraction
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 import fossil_dsl
 from fossil_dsl.ir import expr as E
 from fossil_dsl.kernel.local import negative_near_origin
@@ -171,3 +174,52 @@ def test_the_third_derivative_bounds_go_to_bisection_first_and_a_false_one_still
     false = replace(thirds[0], query=L.conjunction(ball, L.Compare(">", third,
                                                                    E.Num(Fraction(1, 2)))))
     assert discharge(false, spec.states, 10, first="interval").outcome is not Outcome.PROVED
+
+
+def _cubic(quadratic: Fraction, coefficients: dict) -> E.Expr:
+    """-quadratic |x|^2 + sum c x_i x_j x_k over (x0, x1)."""
+    x = (E.Var("x0"), E.Var("x1"))
+    terms = [E.mul(E.Num(-quadratic), E.add(E.power(x[0], E.Num(2)), E.power(x[1], E.Num(2))))]
+    terms += [E.mul(E.Num(c), *(x[i] for i in key)) for key, c in coefficients.items()]
+    return E.add(*terms)
+
+
+def test_one_bound_per_third_derivative_covers_a_ball_one_bound_for_all_cannot():
+    """-|x|^2 + 50 x0^3 + x1^3/10: d^3/dx0^3 = 300 and d^3/dx1^3 = 3/5. One bound for
+    all (4 times 300 for each of the 8 ordered triples) allows radii below 1/600; one
+    per derivative (Cauchy-Schwarz) 1/59, so the ball of 1/100 is covered, and every
+    obligation of the lemma is proved."""
+    from fossil_dsl.kernel.prove import discharge
+    spec = fossil_dsl.loads(PENDULUM)
+    g = _cubic(Fraction(1), {(0, 0, 0): Fraction(50), (1, 1, 1): Fraction(1, 10)})
+    facts = Facts(Claim(spec, {"V": g}, ball_radius=Fraction(1, 100)))
+    assert negative_near_origin(facts, "g", g, "g")
+    assert all(discharge(o, spec.states, 10, first=o.first).proved for o in facts.obligations)
+    wide = Facts(Claim(spec, {"V": g}, ball_radius=Fraction(1, 50)))
+    assert not negative_near_origin(wide, "g", g, "g") and not wide.obligations
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.fractions(Fraction(1, 10), Fraction(2)),
+       st.lists(st.fractions(Fraction(-20), Fraction(20)), min_size=4, max_size=4),
+       st.sampled_from([Fraction(1, 10), Fraction(1, 100), Fraction(1, 1000)]))
+def test_where_the_bounds_are_accepted_the_cubic_is_negative_on_the_punctured_ball(
+        quadratic, coefficients, radius):
+    import math
+    import numpy as np
+    from fossil_dsl.kernel import local
+    keys = [(0, 0, 0), (0, 0, 1), (0, 1, 1), (1, 1, 1)]
+    g = _cubic(quadratic, dict(zip(keys, coefficients)))
+    states = ("x0", "x1")
+    thirds = local._third_derivatives(g, states)
+    mu = local._margin(local._hessian_at_origin(g, states))
+    if local._bounds(thirds, states, radius, mu) is None:
+        return
+    angles = np.linspace(0, 2 * math.pi, 721)
+    for r in (float(radius), float(radius) / 2, float(radius) / 10):
+        for a in angles:
+            x0, x1 = r * math.cos(a), r * math.sin(a)
+            value = -float(quadratic) * r * r + sum(
+                float(c) * [x0, x1][i] * [x0, x1][j] * [x0, x1][k]
+                for (i, j, k), c in zip(keys, coefficients))
+            assert value < 0

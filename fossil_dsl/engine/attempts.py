@@ -222,7 +222,7 @@ def _region_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: flo
                                sos_roa.search)
     if finding is None:
         return None, "no sum-of-squares region of attraction found"
-    refuting, querying = budgets(finding, REACH_REFUTING_SECONDS)
+    refuting, querying = budgets(finding, REACH_REFUTING_SECONDS, deadline)
     return _region_proved(plan, backend, listener, deadline, finding, refuting,
                           querying=querying)
 
@@ -275,7 +275,7 @@ def _reach_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: floa
     if not finding.degree:  # RAR's B alone
         return _learned_beside(plan, backend, listener, deadline, finding)
     return prove_found(plan, backend, listener, deadline, finding,
-                       *budgets(finding, REACH_REFUTING_SECONDS), finding.formulas,
+                       *budgets(finding, REACH_REFUTING_SECONDS, deadline), finding.formulas,
                        prepare=lambda cegis: _set_up(cegis, finding))
 
 

@@ -24,20 +24,24 @@ SOS_QUERY_SECONDS = 5.0
 # learning is the weaker alternative there (probe60/ad08, a tanh ring's RAR: the quartic
 # V's decrease took the interval procedure 6 s; at 5 s, learning then failed in 100 s)
 STAND_IN_QUERY_SECONDS = 15.0
+# or this share of the time left, if more: probe64/am05's degree-4 V (a CSTR with exp)
+# needed 28 s of the interval procedure for its decrease, and learning failed after it
+STAND_IN_SHARE = 0.3
 # for refutations slab by slab (solvers/slab_split.py), where they would settle what the
 # refutations leave: probe65/ao10's decrease, 10 slabs of its pitch at 5-7 s each
 SLAB_SECONDS = 80.0
 SLAB_SHARE = 0.5  # of the run's time left, at most (learning may still do it)
 
 
-def budgets(finding, floor: float) -> tuple[float, float]:
+def budgets(finding, floor: float, deadline: float) -> tuple[float, float]:
     """(seconds of refutations, seconds per solver query) for a program's functions: for
     a stand-in's, the conditions with elementary functions are proved by the solvers
     (probe55/p07: interval), and where the stand-in misled the program the solvers' pass
     finds that in a fraction of a second (probe48/c03: 5 s of refuting to no end before);
     else twice the program's time, at least `floor`."""
     if finding.stand_in:
-        return 2 * finding.seconds, STAND_IN_QUERY_SECONDS
+        share = STAND_IN_SHARE * (deadline - time.monotonic())
+        return 2 * finding.seconds, max(STAND_IN_QUERY_SECONDS, share)
     return max(floor, 2 * finding.seconds), SOS_QUERY_SECONDS
 
 

@@ -81,36 +81,49 @@ def rational_interval(value: Fraction):
     return _codac()[0].Interval(*rational_bounds(value))
 
 
-def enclose(expr: E.Expr) -> tuple[float, float]:
-    """(low, high) floats containing the exact value of a variable-free expression;
-    low > high means the value is undefined (e.g. log of a negative number)."""
+def enclose(expr: E.Expr, box=None) -> tuple[float, float]:
+    """(low, high) floats containing the exact value of a variable-free expression, or
+    every value of the expression on `box` (variable -> (low, high) rationals: natural
+    interval evaluation); low > high means the value is undefined (e.g. log of a
+    negative number)."""
     if isinstance(expr, E.Num):  # no interval arithmetic needed (nor codac's import)
         return rational_bounds(expr.value)
-    with upward_rounding():
-        interval = _enclose(expr)
+    with upward_rounding() as codac:
+        env = {E.Var(name): codac.Interval(rational_bounds(low)[0], rational_bounds(high)[1])
+               for name, (low, high) in (box or {}).items()}
+        interval = _enclose(expr, env)
         if interval.is_empty():
             return (math.inf, -math.inf)
         return (interval.lb(), interval.ub())
 
 
-def _enclose(expr: E.Expr):
+def _enclose(expr: E.Expr, env):
+    """`env`: the variables' intervals, and the intervals of the nodes seen (a
+    derivative's tree shares its subtrees)."""
+    if expr in env:
+        return env[expr]
+    env[expr] = value = _enclosed_node(expr, env)
+    return value
+
+
+def _enclosed_node(expr: E.Expr, env):
     codac = _codac()[0]
     if isinstance(expr, E.Num):
         return rational_interval(expr.value)
     if isinstance(expr, E.Pi):
         return codac.Interval.pi()
     if isinstance(expr, E.Neg):
-        return -_enclose(expr.operand)
+        return -_enclose(expr.operand, env)
     if isinstance(expr, E.Add):
-        return _fold(expr.terms, lambda a, b: a + b)
+        return _fold(expr.terms, lambda a, b: a + b, env)
     if isinstance(expr, E.Mul):
-        return _fold(expr.factors, lambda a, b: a * b)
+        return _fold(expr.factors, lambda a, b: a * b, env)
     if isinstance(expr, E.Div):
-        return _enclose(expr.numerator) / _enclose(expr.denominator)
+        return _enclose(expr.numerator, env) / _enclose(expr.denominator, env)
     if isinstance(expr, E.Pow):
-        return _power(_enclose(expr.base), expr.exponent)
+        return _power(_enclose(expr.base, env), expr.exponent, env)
     if isinstance(expr, E.Apply):
-        return function(expr.func, _enclose(expr.arg))
+        return function(expr.func, _enclose(expr.arg, env))
     raise ValueError(f"cannot enclose {expr!r}: it has variables")
 
 
@@ -128,18 +141,18 @@ def function(name: str, argument, rigorous: bool = True):
     return getattr(codac, name)(argument)
 
 
-def _fold(items, combine):
-    result = _enclose(items[0])
+def _fold(items, combine, env):
+    result = _enclose(items[0], env)
     for item in items[1:]:
-        result = combine(result, _enclose(item))
+        result = combine(result, _enclose(item, env))
     return result
 
 
-def _power(base, exponent: E.Expr):
+def _power(base, exponent: E.Expr, env):
     codac = _codac()[0]
     if isinstance(exponent, E.Num) and exponent.value.denominator == 1:
         return codac.pow(base, int(exponent.value))
-    return codac.exp(_enclose(exponent) * codac.log(base))
+    return codac.exp(_enclose(exponent, env) * codac.log(base))
 
 
 def sign(expr: E.Expr) -> int | None:

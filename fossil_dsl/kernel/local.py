@@ -2,14 +2,17 @@
 
 The lemma (docs/certificates.md, "The ball round the origin"): let g be three times
 differentiable on the ball |x| <= ρ, with g(0) = 0, ∇g(0) = 0, x^T H x / 2 <= -μ |x|^2
-for the Hessian H of g at 0, and every third partial derivative of g bounded by M in
-absolute value on the ball. Taylor's theorem with the Lagrange remainder gives, for
-|x| <= ρ, g(x) <= -μ|x|^2 + (M/6)(|x_1| + ... + |x_n|)^3 <= -μ|x|^2 + (M/6) n^(3/2) |x|^3,
-which is negative for 0 < |x| when 36 μ^2 > M^2 n^3 ρ^2.
+for the Hessian H of g at 0, and each third partial derivative d_ijk g bounded by M_ijk
+in absolute value on the ball. Taylor's theorem with the Lagrange remainder gives, for
+|x| <= ρ, g(x) <= -μ|x|^2 + (1/6) sum_ijk M_ijk |x_i x_j x_k| over the n^3 ordered
+triples, and by Cauchy-Schwarz (sum_ijk (x_i x_j x_k)^2 = |x|^6) the sum is at most
+sqrt(S) |x|^3 with S = sum_ijk M_ijk^2: g < 0 for 0 < |x| when 36 μ^2 > S ρ^2 (with one
+bound M for all, S = n^3 M^2).
 
 Each hypothesis is an obligation like any other (exported, re-checked); the kernel only
-chooses μ and M, from the Hessian's eigenvalues and from the third derivatives at a few
-points, and a poor choice can only leave the lemma unproved.
+chooses μ and the bounds, from the Hessian's eigenvalues and from the third derivatives
+(enclosed on the ball's box, else at a few points), and a poor choice can only leave
+the lemma unproved.
 """
 from __future__ import annotations
 
@@ -44,13 +47,12 @@ def negative_near_origin(facts: Facts, name: str, g: E.Expr, words: str) -> bool
             return False
         mu = _margin(hessian)
         thirds = _third_derivatives(g, states)
-        bound = _bound(thirds.values(), states, rho)
+        bounds = _bounds(thirds, states, rho, mu)
     except (E.ExprError, ValueError, ZeroDivisionError, OverflowError):
         return False
-    n = len(states)
-    if mu is None or bound is None or not 36 * mu ** 2 > bound ** 2 * n ** 3 * rho ** 2:
+    if mu is None or bounds is None:
         return False
-    _obligations(facts, name, words, at_zero, hessian, mu, thirds, bound)
+    _obligations(facts, name, words, at_zero, hessian, mu, thirds, bounds)
     return True
 
 
@@ -95,9 +97,30 @@ def _third_derivatives(g: E.Expr, states) -> dict[tuple[int, ...], E.Expr]:
     return found
 
 
-def _bound(thirds, states, rho: Fraction) -> Fraction | None:
-    """M: M_FACTOR times the largest |third derivative| at the origin and at ±ρ/2 on
-    each axis, rounded up to a short rational."""
+def _bounds(thirds, states, rho: Fraction, mu: Fraction | None) -> dict | None:
+    """M_ijk for which 36 μ^2 > S ρ^2 (see the module's text), or None: each third
+    derivative's enclosure on the ball's box (with 5 % room), else one bound for all,
+    M_FACTOR times the largest |third derivative| at the origin and at ±ρ/2 on each
+    axis. The enclosures are the sharper where the derivatives differ (a CSTR's degree-4
+    V: radius 1/400 against 1/1600), the single bound where the enclosures are loose."""
+    if mu is None:
+        return None
+    box = {s: (-rho, rho) for s in states}
+    enclosed = {key: _short(max(map(abs, enclose(third, box))) * 1.05)
+                for key, third in thirds.items()}
+    if _small_enough(enclosed, rho, mu):
+        return enclosed
+    probed = _short(M_FACTOR * _probed(thirds.values(), states, rho))
+    single = dict.fromkeys(thirds, probed)
+    return single if _small_enough(single, rho, mu) else None
+
+
+def _small_enough(bounds: dict, rho: Fraction, mu: Fraction) -> bool:
+    return None not in bounds.values() and 36 * mu ** 2 > rho ** 2 * _sum_of_squares(bounds)
+
+
+def _probed(thirds, states, rho: Fraction) -> float:
+    """The largest |third derivative| at the origin and at ±ρ/2 on each axis."""
     probes = [{s: E.ZERO for s in states}]
     for s, sign in itertools.product(states, (1, -1)):
         probes.append({t: E.Num(sign * rho / 2) if t == s else E.ZERO for t in states})
@@ -105,13 +128,26 @@ def _bound(thirds, states, rho: Fraction) -> Fraction | None:
     for third in thirds:
         for probe in probes:
             low, high = enclose(traversal.substitute(third, probe))
-            if not math.isfinite(low) or not math.isfinite(high):
-                return None
             largest = max(largest, abs(low), abs(high))
-    return Fraction(math.ceil(M_FACTOR * largest * 1000) + 1, 1000)
+    return largest
 
 
-def _obligations(facts: Facts, name, words, at_zero, hessian, mu, thirds, bound) -> None:
+def _short(value: float) -> Fraction | None:
+    """Above value, a multiple of 1/1000; None for inf or NaN."""
+    return Fraction(math.ceil(value * 1000) + 1, 1000) if math.isfinite(value) else None
+
+
+def _sum_of_squares(bounds: dict) -> Fraction:
+    """S: the sum over the n^3 ordered triples (an unordered one counts 1, 3 or 6 times)."""
+    return sum(_orderings(key) * b ** 2 for key, b in bounds.items())
+
+
+def _orderings(key: tuple[int, ...]) -> int:
+    return math.factorial(len(key)) // math.prod(
+        math.factorial(key.count(i)) for i in set(key))
+
+
+def _obligations(facts: Facts, name, words, at_zero, hessian, mu, thirds, bounds) -> None:
     states, rho, n = facts.states, facts.r, len(facts.states)
     prefix = f"local:{name}"
     facts.obligations.append(Obligation(
@@ -133,6 +169,7 @@ def _obligations(facts: Facts, name, words, at_zero, hessian, mu, thirds, bound)
         L.conjunction(shell, L.Compare(">", form, E.ZERO))))
     ball = facts.ball(rho)
     for (i, j, k), third in thirds.items():
+        bound = bounds[(i, j, k)]
         facts.never(f"{prefix}:third:{i}{j}{k}", f"|d^3 {words}/dx{i}dx{j}dx{k}| <= {bound} on "
                     f"the ball |x| <= {rho}", ball,
                     L.disjunction(L.Compare(">", third, E.Num(bound)),
@@ -140,7 +177,9 @@ def _obligations(facts: Facts, name, words, at_zero, hessian, mu, thirds, bound)
                     # nearly constant on the tiny ball: bisection settles it at once,
                     # where Z3 stalled for its whole share (18 s) on a degree-6 V's
                     first="interval")
+    total = _sum_of_squares(bounds)
     facts.obligations.append(Obligation(
-        f"{prefix}:radius", f"36 μ^2 > M^2 n^3 ρ^2 for μ = {mu}, M = {bound}, n = {n}, "
-        f"ρ = {rho}, so {words} < 0 for 0 < |x| <= ρ",
-        L.Compare("<=", E.Num(36 * mu ** 2), E.Num(bound ** 2 * n ** 3 * rho ** 2))))
+        f"{prefix}:radius", f"36 μ^2 > S ρ^2 for μ = {mu}, S = {total} (the sum of the "
+        f"third derivatives' squared bounds over the {n}^3 ordered triples), ρ = {rho}, "
+        f"so {words} < 0 for 0 < |x| <= ρ",
+        L.Compare("<=", E.Num(36 * mu ** 2), E.Num(total * rho ** 2))))
