@@ -21,7 +21,7 @@ from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, as_listener
 from fossil_dsl.ir import traversal
 from fossil_dsl.kernel import Claim
-from fossil_dsl.kernel.rules import lemma_radius
+from fossil_dsl.engine.lemma_radius import lemma_radius
 from fossil_dsl.plan.compile import Plan, origin_radius, with_conditions
 from fossil_dsl.solvers.api import Backend
 from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES

@@ -16,6 +16,7 @@ the lemma unproved.
 """
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from fractions import Fraction
@@ -46,7 +47,7 @@ def negative_near_origin(facts: Facts, name: str, g: E.Expr, words: str) -> bool
         if hessian is None:
             return False
         mu = _margin(hessian)
-        thirds = _third_derivatives(g, states)
+        thirds = _third_derivatives(g, tuple(states))
         bounds = _bounds(thirds, states, rho, mu)
     except (E.ExprError, ValueError, ZeroDivisionError, OverflowError):
         return False
@@ -89,6 +90,7 @@ def _margin(hessian) -> Fraction | None:
     return Fraction(-largest * float(MU_SHARE)).limit_denominator(10 ** 6) or None
 
 
+@functools.lru_cache(maxsize=8)  # the engine tries one g at several radii
 def _third_derivatives(g: E.Expr, states) -> dict[tuple[int, ...], E.Expr]:
     found = {}
     for i, j, k in itertools.combinations_with_replacement(range(len(states)), 3):

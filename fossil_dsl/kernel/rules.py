@@ -5,9 +5,6 @@ by `Facts.never` itself.
 """
 from __future__ import annotations
 
-from dataclasses import replace
-from fractions import Fraction
-
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir import logic as L
@@ -119,19 +116,6 @@ def ball_strengthenings(form: str, guarantee) -> None:
     for name, add in (("no ball left out, directly", ball_refuted),
                       ("no ball left out", no_ball_left_out)):
         strengthening(form, CONTINUOUS, name=name, guarantee=guarantee)(add)
-
-
-def lemma_radius(claim: Claim, halvings: int = 4) -> Fraction | None:
-    """The largest of r, r/2, ..., r/2^halvings (r: the claim's excluded ball) at which
-    the Taylor lemma's own choices of μ and M pass for V and its change, so that its
-    obligations can cover the ball; None if at none. A choice for the engine, not a
-    proof: the lemma's obligations still decide."""
-    radius = claim.ball_radius
-    for _ in range(halvings + 1):
-        if radius > 0 and no_ball_left_out(Facts(replace(claim, ball_radius=radius))):
-            return radius
-        radius /= 2
-    return None
 
 
 ROA_GUARANTEE = (
