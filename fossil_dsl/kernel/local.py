@@ -11,8 +11,8 @@ bound M for all, S = n^3 M^2).
 
 Each hypothesis is an obligation like any other (exported, re-checked); the kernel only
 chooses μ and the bounds, from the Hessian's eigenvalues and from the third derivatives
-(enclosed on the ball's box, else at a few points), and a poor choice can only leave
-the lemma unproved.
+(their enclosures on the ball's box and their values at a few points), and a poor choice
+can only leave the lemma unproved.
 """
 from __future__ import annotations
 
