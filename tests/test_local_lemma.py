@@ -224,30 +224,3 @@ def test_where_the_bounds_are_accepted_the_cubic_is_negative_on_the_punctured_ba
                 for (i, j, k), c in zip(keys, coefficients))
             assert value < 0
 
-
-LINEAR_BOX = """\
-state x0, x1
-dynamics continuous {
-    x0' = -x0 + x1
-    x1' = -x1 - x1^3
-}
-domain box([-1, -1], [1, 1])
-prove stable
-"""
-
-
-def test_the_engine_leaves_out_a_larger_ball_where_the_lemma_covers_it_and_omega_holds_it():
-    """Up to 8 times the plan's ball where D holds 10 times it (the kernel's ball:room)
-    and V is below half its level on it; never above the plan's ball for a domain of
-    another shape."""
-    from fossil_dsl.engine.lemma_radius import lemma_radius
-    x0, x1 = E.Var("x0"), E.Var("x1")
-    V = E.add(E.power(x0, E.Num(2)), E.power(x1, E.Num(2)))
-    spec = fossil_dsl.loads(LINEAR_BOX)
-    r = Fraction(1, 100)
-    assert lemma_radius(Claim(spec, {"V": V}, ball_radius=r)) == 8 * r
-    small_omega = Claim(spec, {"V": V}, levels={"beta": Fraction(1, 100)}, ball_radius=r)
-    assert lemma_radius(small_omega) == 4 * r  # V = 0.0064 at 0.08, above 0.01 / 2
-    shifted = fossil_dsl.loads(LINEAR_BOX.replace("box([-1, -1], [1, 1])",
-                                                  "box([-1, -1], [1, 1]) - ball([0.5, 0.5], 0.1)"))
-    assert lemma_radius(Claim(shifted, {"V": V}, ball_radius=r)) == r
