@@ -111,8 +111,7 @@ def _bounds(thirds, states, rho: Fraction, mu: Fraction | None) -> dict | None:
         return None
     box = {s: (-rho, rho) for s in states}
     single = _short(M_FACTOR * _probed(thirds.values(), states, rho))
-    bounds = {key: min(filter(None, (_short(max(map(abs, enclose(third, box))) * 1.05),
-                                     single)), default=None)
+    bounds = {key: _lesser(_short(1.05 * max(map(abs, enclose(third, box)))), single)
               for key, third in thirds.items()}
     if None in bounds.values() or not 36 * mu ** 2 > rho ** 2 * _sum_of_squares(bounds):
         return None
@@ -135,6 +134,11 @@ def _probed(thirds, states, rho: Fraction) -> float:
             low, high = enclose(traversal.substitute(third, probe))
             largest = max(largest, abs(low), abs(high))
     return largest
+
+
+def _lesser(a: Fraction | None, b: Fraction | None) -> Fraction | None:
+    """The smaller bound, where either is known."""
+    return b if a is None else a if b is None else min(a, b)
 
 
 def _short(value: float) -> Fraction | None:
