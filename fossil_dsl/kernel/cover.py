@@ -60,7 +60,7 @@ def hull_of(query: L.Formula, names: Sequence[str]) -> Box | None:
     """A box round what interval contraction leaves of the query, a little wider (so the
     piece outside it is refuted at once); None if none is bounded. Any box would do: it
     only decides where the cuts fall."""
-    from fossil_dsl.solvers.interval_backend import hull
+    from fossil_dsl.solvers.interval_hull import hull
     found = hull(query, names) if names else None
     if found is None:
         return None

@@ -159,6 +159,7 @@ def _split_at_ball(obligation: Obligation, states, timeout: float, delta,
 def _arithmetic(obligation: Obligation, states, timeout: float, delta, first: str,
                 pieces) -> Proof:
     early = len(states) >= BEFORE_Z3_FROM  # the refutation before Z3
+    first = "interval" if first == "taylor" else first  # (which tries Taylor forms first)
     # Z3 stalls for its whole share on polynomials of high degree (a degree-8 V shaped
     # to a basin: 18 s per condition) where the interval procedure answers in seconds
     high = bisection_first(obligation.query, states)
@@ -224,8 +225,8 @@ def _interval(obligation: Obligation, states, timeout: float, delta, pieces=None
         return split
     backend = IntervalBackend(delta) if delta else IntervalBackend()
     answer = backend.check(obligation.query, states, timeout)
-    if answer.status is Status.UNSAT:
-        return Proof(obligation, Outcome.PROVED, "interval")
+    if answer.status is Status.UNSAT:  # by codac, or by the Taylor forms it tries first
+        return Proof(obligation, Outcome.PROVED, answer.solver or "interval")
     return Proof(obligation, Outcome.NOT_PROVED, "interval", _reason(answer),
                  _point(answer, states))
 

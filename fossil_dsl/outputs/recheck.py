@@ -39,7 +39,7 @@ from fossil_dsl.syntax.parser import parse_expression, parse_source
 # sum-of-squares procedure comes second: it shares no code with the SMT solvers, and
 # what it finds is checked in exact arithmetic (4- to 6-state flow conditions that Z3
 # proved in the run were left UNKNOWN by CVC5 and the interval search at 10 s each).
-POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "arb", "dreal")
+POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "arb", "taylor", "dreal")
 # ... but Arb first for a polynomial of high degree in few states (kernel/prove.py's
 # rule for the interval procedure): a degree-8 decrease condition of a V shaped to a
 # basin, which the interval procedure proved in the run, was left UNKNOWN by CVC5, the
@@ -50,14 +50,17 @@ POLYNOMIAL_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "arb", "dreal")
 # A refutation of the polynomial form goes before Arb: it settles at once what Arb's
 # bisection, which has no contraction, needs boxes for (the part of a 4-state decrease
 # condition beyond a ball, where V <= β and |x| >= R meet in no point: 39 s by Arb).
-TRANSCENDENTAL_ORDER = ("dreal", "interval", SUM_OF_SQUARES, "arb", "cvc5")
+TRANSCENDENTAL_ORDER = ("dreal", "interval", SUM_OF_SQUARES, "arb", "taylor", "cvc5")
 # division and abs: decided by the SMT solvers (a delta-decision procedure cannot refute
 # the boxes round the origin where a rational V's decrease vanishes), and by a refutation
 # where the divisors are evidently positive (probe43/x06's decrease, proved by a solver
 # in a run on a loaded machine, is left UNKNOWN by CVC5, Z3, the interval search and Arb
 # at 12 s each; its refutation takes a second)
-ARITHMETIC_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "arb", "dreal")
-RECHECK_ONLY = (SUM_OF_SQUARES, "arb")  # procedures that are not verifiers of a run
+ARITHMETIC_ORDER = ("cvc5", SUM_OF_SQUARES, "z3", "interval", "arb", "taylor", "dreal")
+# procedures that are not verifiers of a run; "taylor" (solvers/taylor_boxes.py, numpy
+# and its own elementary functions) is the interval verifier's first try in a run, and
+# here apart from it: "interval" re-checks with codac alone
+RECHECK_ONLY = (SUM_OF_SQUARES, "arb", "taylor")
 
 
 class RecheckError(FslError):
@@ -273,6 +276,12 @@ def _backend(name: str):
     if name == "arb":
         from fossil_dsl.solvers.arb_backend import ArbBackend
         return ArbBackend()
+    if name == "taylor":
+        from fossil_dsl.solvers import taylor_boxes
+        return taylor_boxes
+    if name == "interval":
+        from fossil_dsl.solvers.interval_backend import IntervalBackend
+        return IntervalBackend(taylor=False)
     return registry.load(name)
 
 

@@ -116,7 +116,7 @@ def split_query(query: L.Formula, states: Sequence[str], deadline: float
 
 def outer_radius(query: L.Formula, names: Sequence[str]) -> float:
     """The largest |x| in the box that contraction leaves of the query (0: none)."""
-    from fossil_dsl.solvers.interval_backend import hull
+    from fossil_dsl.solvers.interval_hull import hull
     box = hull(query, list(names))
     if box is None:
         return 0.0

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import threading
 import time
+from dataclasses import replace
 from collections import Counter
 from fractions import Fraction
 from typing import Sequence
@@ -27,6 +28,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import function, rational_interval, upward_rounding
 from fossil_dsl.ir.sharing import worth_naming
 from fossil_dsl.solvers.api import Answer, Status, UnsupportedTheory
+from fossil_dsl.solvers import taylor_boxes
 
 DELTA = 1e-4  # the width under which a surviving box counts as a (delta-)solution
 WITNESS_SEARCH = 2000  # boxes searched for a better witness after a doubtful one
@@ -35,8 +37,8 @@ WITNESS_SEARCH = 2000  # boxes searched for a better witness after a doubtful on
 class IntervalBackend:
     name = "interval"
 
-    def __init__(self, delta: float = DELTA, leads_only: bool = False):
-        self.delta = delta
+    def __init__(self, delta: float = DELTA, leads_only: bool = False, taylor: bool = True):
+        self.delta, self.taylor = delta, taylor  # taylor: taylor_boxes goes first
         # leads_only: codac's own tanh, not outward-rounded but three times faster to
         # search with; for the CEGIS loop, whose answers the kernel judges again
         self.rigorous = not leads_only
@@ -46,14 +48,18 @@ class IntervalBackend:
         # slice of 10 s) resumes it: am05's decrease took 28 s, and was asked for 10 s,
         # then 24 s from the start again
         self._paused = None
+        self._taylor = None  # (query, names) and taylor_boxes' search on it
 
     def check(self, formula: L.Formula, variables: Sequence[str], timeout: float,
               stop: threading.Event | None = None) -> Answer:
         names = sorted(set(variables) | L.free_vars(formula))
         deadline = time.monotonic() + timeout
         key, paused, self._paused = (formula, tuple(names)), self._paused, None
+        resumed = paused is not None and paused[0] == key
+        if (found := self._taylor_first(key, formula, names, timeout)) is not None:
+            return found
         with upward_rounding() as codac:
-            if paused is not None and paused[0] == key:
+            if resumed:
                 return self._search(*paused[1:], names, variables, deadline, stop, key)
             try:
                 compiler = _Compiler(codac, names, self.rigorous, _named_terms(formula))
@@ -68,6 +74,19 @@ class IntervalBackend:
             split = _worth_splitting(formula, names)
             return self._search(contractor, [start], split, names, variables, deadline,
                                 stop, key)
+
+    def _taylor_first(self, key, formula, names, timeout: float) -> Answer | None:
+        """taylor_boxes' UNSAT within its share of the time, or None (resumed where a
+        call asks the same query again). A point where the query holds only ends it:
+        codac's delta-solutions lie nearer the sets' edges, as refinements from
+        counterexamples need (tests/test_conserved.py, the unicycle)."""
+        if not (self.taylor and taylor_boxes.share(names)):
+            return None
+        if self._taylor is None or self._taylor[0] != key:
+            self._taylor = (key, taylor_boxes.Search(formula, names))
+        answer = self._taylor[1].run(taylor_boxes.share(names) * timeout)
+        return replace(answer, solver=taylor_boxes.NAME) \
+            if answer.status is Status.UNSAT else None
 
     def check_within(self, query: L.Formula, region: L.Formula, variables: Sequence[str],
                      timeout: float, stop: threading.Event | None = None) -> Answer:
@@ -145,23 +164,6 @@ def _settled_at_once(contractor, start, dimension: int) -> Answer | None:
     if any(start[i].is_unbounded() for i in range(dimension)):
         return _unbounded()
     return None
-
-
-def hull(formula: L.Formula, names: Sequence[str]) -> list[tuple[float, float]] | None:
-    """The box contraction leaves of the whole space (outward-rounded), per name; None
-    if it is empty or unbounded, or the formula is outside the procedure's theory."""
-    with upward_rounding() as codac:
-        try:
-            contractor = _Compiler(codac, names).formula(formula)
-        except UnsupportedTheory:
-            return None
-        if contractor is None:
-            return None
-        box = codac.IntervalVector([[-codac.oo, codac.oo]] * len(names))
-        _contract_to_fixpoint(contractor, box, len(names), passes=5)
-        if box.is_empty() or box.is_unbounded():
-            return None
-        return [(box[i].lb(), box[i].ub()) for i in range(len(names))]
 
 
 def _middle_may_satisfy(contractor, box, dimension: int) -> bool:

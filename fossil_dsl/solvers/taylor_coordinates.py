@@ -1,0 +1,89 @@
+"""Coordinates in which a query's main function has unit curvature, for taylor_boxes.py.
+
+With H the Hessian of the query's largest smooth side at the origin (or the hull's
+centre), H = U diag(l) U^T, the substitution x = T z with T = U diag(|l|^(-1/2)) (its
+entries rounded to rationals) gives an equivalent query in z: a point z satisfies it
+exactly when x = T z satisfies the original (T is invertible, checked exactly). In z the
+side's second-order part is a sum of +-z_i^2, so the Taylor form's off-diagonal terms,
+which interval arithmetic bounds by |H_ij| w_i w_j whatever the signs, nearly vanish, and
+boxes can be wide.
+
+Why: the acrobot's LQR decrease has curvatures from 0.1 to 40 in the states; in them the
+search needed boxes 0.15 of their distance from the origin wide (65 000 per doubling of
+the radius); in z, ... (docs/verifiers.md).
+"""
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
+from fossil_dsl.ir.enclosure import rational_bounds
+
+DIGITS = 10 ** 6  # T's entries: multiples of 1e-6 of its largest
+WORTH = 3.0  # below this ratio of the curvatures the states are used as they are
+FLOOR = 1e-6  # of the largest curvature: smaller ones are raised to it
+
+
+def transform(hessian: np.ndarray) -> list[list[Fraction]] | None:
+    """T (rationals, invertible) with T^T H T about diag(+-1), or None where H's
+    curvatures are within WORTH of each other (or not finite)."""
+    if not np.all(np.isfinite(hessian)):
+        return None
+    values, vectors = np.linalg.eigh((hessian + hessian.T) / 2)
+    sizes = np.abs(values)
+    if sizes.max() <= 0 or sizes.max() / max(sizes.min(), 1e-300) < WORTH:
+        return None
+    sizes = np.maximum(sizes, FLOOR * sizes.max())
+    numeric = vectors / np.sqrt(sizes)
+    unit = np.abs(numeric).max()
+    T = [[Fraction(round(v / unit * DIGITS)) * Fraction(unit).limit_denominator(DIGITS)
+          / DIGITS for v in row] for row in numeric]
+    return T if _inverse(T) is not None else None
+
+
+def substituted(formula: L.Formula, names, T, hull):
+    """(the query in z, z's names, z's hull) for x = T z, from x's hull."""
+    z_names = tuple(_fresh(names, i) for i in range(len(names)))
+    z = [E.Var(n) for n in z_names]
+    mapping = {name: E.add(*[E.mul(E.Num(T[i][j]), z[j]) for j in range(len(names))
+                             if T[i][j]]) for i, name in enumerate(names)}
+    inverse = _inverse(T)
+    z_hull = []
+    for row in inverse:
+        low = sum(min(c * Fraction(lo), c * Fraction(hi)) for c, (lo, hi) in zip(row, hull))
+        high = sum(max(c * Fraction(lo), c * Fraction(hi)) for c, (lo, hi) in zip(row, hull))
+        z_hull.append((rational_bounds(low)[0], rational_bounds(high)[1]))
+    return L.substitute(formula, mapping), z_names, z_hull
+
+
+def back(T, z_point) -> list[Fraction]:
+    """x = T z, exactly."""
+    return [sum(T[i][j] * z_point[j] for j in range(len(z_point))) for i in range(len(T))]
+
+
+def _fresh(names, index: int) -> str:
+    name = f"z{index}"
+    while name in names:
+        name += "_"
+    return name
+
+
+def _inverse(T) -> list[list[Fraction]] | None:
+    """The exact inverse by Gauss-Jordan elimination, or None if T is singular."""
+    n = len(T)
+    rows = [list(row) + [Fraction(int(i == j)) for j in range(n)] for i, row in enumerate(T)]
+    for column in range(n):
+        pivot = next((r for r in range(column, n) if rows[r][column] != 0), None)
+        if pivot is None:
+            return None
+        rows[column], rows[pivot] = rows[pivot], rows[column]
+        lead = rows[column][column]
+        rows[column] = [v / lead for v in rows[column]]
+        for r in range(n):
+            if r != column and rows[r][column] != 0:
+                factor = rows[r][column]
+                rows[r] = [a - factor * b for a, b in zip(rows[r], rows[column])]
+    return [row[n:] for row in rows]
