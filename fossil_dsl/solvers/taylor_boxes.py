@@ -17,9 +17,10 @@ non-strict (a larger set) for refuting, so an UNSAT holds for the query as writt
 
 Why: a decrease condition near a stable equilibrium is a sum of terms that cancel to
 -mu |x|^2; natural interval extensions lose the cancellation in proportion to the box's
-width, the Taylor form keeps it to second order, so boxes a fifth of their distance
-from the origin wide suffice where the natural extension needs a thirtieth (the
-acrobot's LQR function: 8e5 boxes in all, against more than 3e7 per shell of radius).
+width, the Taylor form keeps it to second order, so boxes a sixth of their distance
+from the origin wide suffice where codac needs a thirtieth (probe67/aq18, the acrobot:
+its LQR candidate's decrease in 962 000 boxes, 259 000 in unit-curvature coordinates;
+codac had no end after 3.2 million; docs/benchmarks.md, session 68).
 """
 from __future__ import annotations
 

@@ -8,9 +8,11 @@ side's second-order part is a sum of +-z_i^2, so the Taylor form's off-diagonal 
 which interval arithmetic bounds by |H_ij| w_i w_j whatever the signs, nearly vanish, and
 boxes can be wide.
 
-Why: the acrobot's LQR decrease has curvatures from 0.1 to 40 in the states; in them the
-search needed boxes 0.15 of their distance from the origin wide (65 000 per doubling of
-the radius); in z, ... (docs/verifiers.md).
+Why: the acrobot's LQR decrease (probe67/aq18) has curvatures from 0.55 to 161 at the
+origin; in the states the search needed boxes 0.15 of their distance from the origin
+wide (65 000 per doubling of the radius, 962 000 boxes in 20 s in all), in z boxes as
+wide as their distance near the origin (259 000 boxes in 15 s; docs/benchmarks.md,
+session 68).
 """
 from __future__ import annotations
 
