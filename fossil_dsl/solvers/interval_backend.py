@@ -80,11 +80,11 @@ class IntervalBackend:
         call asks the same query again). A point where the query holds only ends it:
         codac's delta-solutions lie nearer the sets' edges, as refinements from
         counterexamples need (tests/test_conserved.py, the unicycle)."""
-        if not (self.taylor and taylor_boxes.share(names)):
+        if not (share := taylor_boxes.share(names) if self.taylor else 0.0):
             return None
         if self._taylor is None or self._taylor[0] != key:
             self._taylor = (key, taylor_boxes.Search(formula, names))
-        answer = self._taylor[1].run(taylor_boxes.share(names) * timeout)
+        answer = self._taylor[1].run(share * timeout)
         return replace(answer, solver=taylor_boxes.NAME) \
             if answer.status is Status.UNSAT else None
 

@@ -97,20 +97,19 @@ class Search:
         self.transform, self.stack, self.boxes = None, [], 0
         self.answer: Answer | None = None
         hull = starting_box(formula, list(self.names))
+        if hull is None:
+            self.answer = Answer(Status.UNKNOWN, reason="the query bounds no box")
+            return
         try:
-            tree = _compiled(formula, self.names) if hull is not None else None
+            tree = _compiled(formula, self.names)
             with np.errstate(all="ignore"):
-                self.transform = None if hull is None else \
-                    _unit_curvature(tree, self.names, hull)
+                self.transform = _unit_curvature(tree, self.names, hull)
             if self.transform is not None:
                 formula, z_names, hull = coordinates.substituted(formula, self.names,
                                                                  self.transform, hull)
                 tree = _compiled(formula, z_names)
         except UnsupportedTheory as exc:
             self.answer = Answer(Status.UNKNOWN, reason=str(exc))
-            return
-        if hull is None:
-            self.answer = Answer(Status.UNKNOWN, reason="the query bounds no box")
             return
         self.tree, self.searched = tree, z_names if self.transform else self.names
         self.stack = [(np.array([[lo for lo, _ in hull]]), np.array([[hi for _, hi in hull]]))]
@@ -168,9 +167,9 @@ def _unit_curvature(tree, names, hull):
         return None
     main = max(sides, key=lambda side: sum(1 for _ in E.walk(side.expr)))
     at_origin = all(lo <= 0 <= hi for lo, hi in hull)
-    point = {n: np.array([0.0 if at_origin else (lo + hi) / 2] * 2)
+    point = {n: np.array([0.0 if at_origin else (lo + hi) / 2])
              for n, (lo, hi) in zip(names, hull)}
-    env, memo = {n: (v[:1], v[:1]) for n, v in point.items()}, {}
+    env, memo = {n: (v, v) for n, v in point.items()}, {}
     hessian = np.zeros((len(names), len(names)))
     for (i, j), entry in main.hessian.items():
         low, high = enclose(entry, env, memo)

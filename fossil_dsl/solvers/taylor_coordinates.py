@@ -74,18 +74,14 @@ def _fresh(names, index: int) -> str:
 
 
 def _inverse(T) -> list[list[Fraction]] | None:
-    """The exact inverse by Gauss-Jordan elimination, or None if T is singular."""
+    """T^-1 in exact rationals (FLINT), or None if T is singular."""
+    import flint
     n = len(T)
-    rows = [list(row) + [Fraction(int(i == j)) for j in range(n)] for i, row in enumerate(T)]
-    for column in range(n):
-        pivot = next((r for r in range(column, n) if rows[r][column] != 0), None)
-        if pivot is None:
-            return None
-        rows[column], rows[pivot] = rows[pivot], rows[column]
-        lead = rows[column][column]
-        rows[column] = [v / lead for v in rows[column]]
-        for r in range(n):
-            if r != column and rows[r][column] != 0:
-                factor = rows[r][column]
-                rows[r] = [a - factor * b for a, b in zip(rows[r], rows[column])]
-    return [row[n:] for row in rows]
+    matrix = flint.fmpq_mat(n, n, [flint.fmpq(v.numerator, v.denominator)
+                                   for row in T for v in row])
+    try:
+        inverse = matrix.inv()
+    except ZeroDivisionError:
+        return None
+    return [[Fraction(int(inverse[i, j].p), int(inverse[i, j].q)) for j in range(n)]
+            for i in range(n)]
