@@ -124,6 +124,18 @@ def unstable_roa(data):
     assert_never_certified(spec, {"V": data.draw(candidate(states))}, {"beta": beta})
 
 
+def roa_through_a_face(data):
+    """x' = a x (x - 1): the points of I on D's face x = 1 are equilibria, not the origin
+    (the kernel's variant for regions that reach the boundary must refuse it)."""
+    states = STATES[2]
+    a = to_text_number(Fraction(data.draw(st.integers(1, 8)), 4))
+    rest = ("domain box([-0.5, -1], [1, 1])\nset init = box([0.8, -0.2], [1, 0.2])\n"
+            "prove from init: stable\n")
+    spec = spec_of(states, [f"{a}*x0*(x0 - 1)", "-x1"], rest)
+    beta = Fraction(data.draw(st.integers(1, 50)), 10)
+    assert_never_certified(spec, {"V": data.draw(candidate(states))}, {"beta": beta})
+
+
 def unsafe_drift(data):
     """x' = v: the initial box drifts into the unsafe box, which lies on its path."""
     states = STATES[2]
@@ -152,7 +164,8 @@ def goal_never_reached(data):
 
 CASES = {"stability": lambda d: unstable_stability(d, "continuous"),
          "discrete stability": lambda d: unstable_stability(d, "discrete"),
-         "roa": unstable_roa, "safety": unsafe_drift, "reach": goal_never_reached}
+         "roa": unstable_roa, "roa through a face": roa_through_a_face,
+         "safety": unsafe_drift, "reach": goal_never_reached}
 
 
 @pytest.mark.parametrize("kind", sorted(CASES))

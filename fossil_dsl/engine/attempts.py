@@ -97,7 +97,8 @@ def _learning_imported(plan: Plan) -> float:
 def _variant_plan(plan: Plan) -> Plan | None:
     """The plan with the conditions of the kernel rule's variant, if it has one."""
     conditions = plan.certificate.variant_conditions()
-    return None if conditions is None else with_conditions(plan, conditions)
+    return None if conditions is None or tuple(conditions) == plan.conditions else \
+        with_conditions(plan, conditions, plan.certificate.variant_levels())
 
 
 def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):

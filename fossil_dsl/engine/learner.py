@@ -21,7 +21,7 @@ from fossil_dsl.engine.sampling import box_centre, sample
 from fossil_dsl.engine.violations import ViolationSearch
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.base import (Condition, Level, change_of, level_of,
-                                               next_value, value_of)
+                                               next_value, value_of, velocity_of)
 from fossil_dsl.plan.compile import Plan
 
 FRESH_SEARCHES = 5  # searches of fresh samples per training round, at most
@@ -63,6 +63,7 @@ class Learner(ViolationSearch):
         needed = set().union(*self._placeholders.values())
         self.changes_needed = frozenset(n for n in needed if n.startswith("$d"))
         self.next_needed = any(next_value(s).name in needed for s in self.states)
+        self.velocity_needed = any(velocity_of(s).name in needed for s in self.states)
         self.control_target, self.control_samples = self.controller_samples() \
             if self.controller is not None else (None, None)
         # the linearisation's quadratic V or B (and LQR controller) as the starting point
@@ -150,9 +151,10 @@ class Learner(ViolationSearch):
         """Each named function's value and change (derivative along the flow, or
         one-step difference) at the points, which must require gradients."""
         result, field = {}, None
-        if self.next_needed:  # f(x) itself, for claims such as f(x) ∈ S
+        if self.next_needed or self.velocity_needed:  # f(x), for claims such as f(x) ∈ S
             field = self.field(points)
-            result.update({next_value(s).name: f for s, f in zip(self.states, field)})
+            placeholder = next_value if self.next_needed else velocity_of
+            result.update({placeholder(s).name: f for s, f in zip(self.states, field)})
         for name in names:
             value = self.function(name, points)
             result[value_of(name).name] = value

@@ -15,7 +15,8 @@ from typing import Callable
 from fossil_dsl.engine.course import AFTER_A_FAILURE, failed, stalled, undecided_again
 from fossil_dsl.engine.falsify import Falsifier
 from fossil_dsl.engine.given import GivenFunctions, verifier_only
-from fossil_dsl.plan.certificates.base import change_of, level_of, next_value, value_of
+from fossil_dsl.plan.certificates.base import change_of, level_of, next_value, value_of, \
+    velocity_of
 from fossil_dsl.ir import calculus
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
@@ -73,9 +74,11 @@ class ExactCandidate:
     levels: dict[str, Fraction]
     digits: int  # decimals kept when the weights were rounded
     next_state: dict[str, E.Expr] = field(default_factory=dict)  # discrete: state -> f(x)
+    velocity: dict[str, E.Expr] = field(default_factory=dict)  # continuous: state -> f(x)
 
     def mapping(self) -> dict[str, E.Expr]:
         found = {next_value(s).name: f for s, f in self.next_state.items()}
+        found.update({velocity_of(s).name: f for s, f in self.velocity.items()})
         found.update({value_of(n).name: f for n, f in self.formulas.items()})
         found.update({change_of(n).name: c for n, c in self.changes.items()})
         found.update({level_of(n).name: E.Num(v) for n, v in self.levels.items()})
@@ -266,9 +269,11 @@ class Cegis:
         changes = {name: self.change(formula, closed_loop) for name, formula in formulas.items()}
         levels = {name: Fraction(learner.fixed_levels[name]) if name in learner.fixed_levels
                   else rational(value, digits) for name, value in learner.levels().items()}
-        next_state = dict(zip(self.states, closed_loop)) \
-            if self.plan.spec.time is TimeDomain.DISCRETE else {}
-        return ExactCandidate(formulas, changes, controller, levels, digits, next_state)
+        discrete = self.plan.spec.time is TimeDomain.DISCRETE
+        next_state = dict(zip(self.states, closed_loop)) if discrete else {}
+        velocity = {} if discrete else dict(zip(self.states, closed_loop))
+        return ExactCandidate(formulas, changes, controller, levels, digits, next_state,
+                              velocity)
 
     def change(self, formula: E.Expr, dynamics) -> E.Expr:
         discrete = self.plan.spec.time is TimeDomain.DISCRETE

@@ -2,8 +2,8 @@
 
 It takes the checked spec and the final exact functions (a `Claim`), derives every
 obligation the guarantee rests on (`obligations.py`; the rules by property and time
-domain in `registry.py`: `rules.py`, `safety_rules.py`, `step_rules.py` for difference
-equations; `definedness.py`), discharges each with a sound procedure (`prove.py`) and
+domain in `registry.py`: `rules.py`, `safety_rules.py`, `inward_rules.py`, `step_rules.py`
+for difference equations; `definedness.py`), discharges each with a sound procedure (`prove.py`) and
 returns the verdict (`verdict.py`: the main rule, else its variants). It imports the IR and the solvers only: no torch, no learner.
 """
 from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation

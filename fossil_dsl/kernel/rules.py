@@ -143,9 +143,11 @@ def stability(facts: Facts) -> None:
 ball_strengthenings("stability", stability_guarantee)
 
 
-def stable_sublevel_set(facts: Facts) -> None:
+def stable_sublevel_set(facts: Facts, kept=None) -> None:
     """Ω = {x in D : V(x) <= β} cannot be left, and V is a strict Lyapunov function on
-    it: every trajectory from Ω converges to the origin, and the origin is stable."""
+    it: every trajectory from Ω converges to the origin, and the origin is stable.
+    `kept` (continuous time) adds the obligations that keep Ω in place of V > β on ∂D
+    (inward_rules.py)."""
     equilibrium(facts, "V")
     neighbourhood(facts)
     V, beta = facts.value("V"), facts.level("beta")
@@ -153,6 +155,8 @@ def stable_sublevel_set(facts: Facts) -> None:
     if facts.discrete:  # a step can jump over ∂D: it must land in D (step_rules.py)
         facts.lands_in("condition:image", "f(x) lies in D for every x in D with V(x) <= β",
                        L.conjunction(facts.member(domain), compare("<=", V, beta)), domain)
+    elif kept is not None:
+        kept(facts)
     else:
         facts.holds("condition:boundary", "V(x) > β on the boundary of D",
                     facts.boundary(domain), compare(">", V, beta))
@@ -167,8 +171,8 @@ def stable_sublevel_set(facts: Facts) -> None:
                     compare("<", V, beta))
 
 
-def region_of_attraction(facts: Facts) -> None:
-    stable_sublevel_set(facts)
+def region_of_attraction(facts: Facts, kept=None) -> None:
+    stable_sublevel_set(facts, kept)
     V, beta = facts.value("V"), facts.level("beta")
     initial = facts.role("initial")
     facts.inside("relation:initial in domain", "I lies in D", facts.member(initial),

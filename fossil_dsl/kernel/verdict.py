@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-from fossil_dsl.kernel import rules, safety_rules, step_rules  # noqa: F401  (registers them)
+from fossil_dsl.kernel import inward_rules, rules, safety_rules, step_rules  # noqa: F401 (rules)
 from fossil_dsl.kernel.obligations import Claim, NoRule, Obligation
 from fossil_dsl.kernel.registry import (derive, derive_facts, derive_strengthenings,
                                         rule_variants)

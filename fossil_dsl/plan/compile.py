@@ -106,7 +106,7 @@ def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None
     functions = rule.functions()
     for function in functions:
         _check_candidate(spec, function)
-    conditions = rule.conditions()
+    conditions, levels = rule.chosen_conditions()
     controller = _controller(spec, rule)
     requested = overrides.pop("verifier", None)
     verifier, reason = choose_verifier(spec, functions, controller, requested)
@@ -116,7 +116,7 @@ def compile_spec(spec: CheckedSpec, certificate: type[Certificate] | None = None
     fallback = None if requested or spec.synthesis.verifier else _fallback(verifier)
     if fallback:
         reason += f"; where it does not answer at once, {fallback} alongside"
-    return Plan(spec, rule, functions, conditions, tuple(rule.levels()), controller,
+    return Plan(spec, rule, functions, conditions, tuple(levels), controller,
                 verifier, reason, MappingProxyType(samples), options, radius, fallback)
 
 
@@ -134,11 +134,12 @@ def default_synthesis(plan: Plan) -> bool:
             and spec.synthesis.candidate is None and not plan.options.learn_only)
 
 
-def with_conditions(plan: Plan, conditions) -> Plan:
-    """The plan with other conditions (those of a variant of the kernel's rule), and
-    their sample counts."""
+def with_conditions(plan: Plan, conditions, levels=None) -> Plan:
+    """The plan with other conditions (those of a variant of the kernel's rule), their
+    sample counts, and the levels that go with them."""
     samples = {c.name: _sample_count(plan.spec, c.region) for c in conditions}
-    return replace(plan, conditions=tuple(conditions), samples=MappingProxyType(samples))
+    return replace(plan, conditions=tuple(conditions), samples=MappingProxyType(samples),
+                   levels=plan.levels if levels is None else tuple(levels))
 
 
 def origin_radius(spec: CheckedSpec) -> Fraction:

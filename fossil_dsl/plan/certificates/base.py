@@ -43,6 +43,12 @@ def next_in(states, region: SetExpr) -> L.Formula:
     return L.substitute(formula, {s: next_value(s) for s in states})
 
 
+def velocity_of(state: str) -> E.Var:
+    """The placeholder for the closed loop's velocity, coordinate `state` (continuous
+    time): f(x)_state, for claims such as "the field points into D on its face"."""
+    return E.Var(f"$velocity_{state}")
+
+
 def level_of(name: str) -> E.Var:
     """The placeholder for a level (a number chosen from data at each iteration)."""
     return E.Var(f"${name}")
@@ -158,6 +164,15 @@ class Certificate:
         """The conditions of a variant of the kernel's rule (kernel/registry.py), to
         try where the main ones cannot be met; None where there is none."""
         return None
+
+    def chosen_conditions(self) -> tuple[tuple[Condition, ...], tuple[Level, ...]]:
+        """The conditions and levels to learn: the main rule's, or the variant's where
+        the main ones evidently cannot be met (roa.py: I touches ∂D)."""
+        return self.conditions(), self.levels()
+
+    def variant_levels(self) -> tuple[Level, ...]:
+        """The levels that go with the variant's conditions."""
+        return self.levels()
 
     @property
     def discrete(self) -> bool:

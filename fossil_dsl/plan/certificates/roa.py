@@ -4,15 +4,16 @@ from __future__ import annotations
 from fractions import Fraction
 
 from fossil_dsl.plan.certificates.base import (Certificate, Condition, Level, change_of, level_of,
-                                               register, value_of)
+                                               register, value_of, velocity_of)
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
-from fossil_dsl.ir.sets import Ball, Boundary, SetExpr
-from fossil_dsl.ir.spec import Layer
+from fossil_dsl.ir.sets import Ball, Boundary, Box, SetExpr
+from fossil_dsl.ir.spec import Layer, TimeDomain
 
 DEFAULT_LAYERS = (Layer("square", 8),)
 # the forms whose certificate is a V with a sublevel set Ω in the region of attraction
 ROA_FORMS = ("region of attraction", "largest region of attraction")
+INWARD = "inward:"  # the names of the variant's conditions on D's faces
 
 
 def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta",
@@ -44,6 +45,50 @@ def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta
     )
 
 
+def inward_conditions(certificate: Certificate, name: str = "V",
+                      level: str = "beta") -> tuple[Condition, ...] | None:
+    """For Ω reaching ∂D (continuous time, D a box; kernel/inward_rules.py): on each face
+    of D, where V <= β, the field points into D. None where the variant does not apply."""
+    domain = certificate.spec.domain
+    if certificate.discrete or not isinstance(domain, Box):
+        return None
+    inside_level = L.Compare("<=", value_of(name), level_of(level))
+    found = []
+    for i, state in enumerate(certificate.spec.states):
+        for end, relation, side in ((domain.lower[i], ">", "lower"),
+                                    (domain.upper[i], "<", "upper")):
+            lower, upper = list(domain.lower), list(domain.upper)
+            lower[i] = upper[i] = end
+            found.append(Condition(
+                f"{INWARD}{state}:{side}", f"the field points into D on its face {state} = "
+                f"{E.to_text(end)} where {name}(x) <= β", Box(tuple(lower), tuple(upper)),
+                L.Compare(relation, velocity_of(state), E.ZERO), guard=inside_level))
+    return tuple(found)
+
+
+def initial_reaches_boundary(spec) -> bool:
+    """I's bounding box meets a face of D's (where no sublevel set holding I fits inside
+    D: the variant's conditions are the ones to learn)."""
+    initial, domain = spec.property.role("initial"), spec.domain.bounding_box()
+    inner = initial.bounding_box() if initial is not None else None
+    if spec.time is not TimeDomain.CONTINUOUS or inner is None or domain is None:
+        return False
+    return any(a <= low or b >= high for a, b, low, high in zip(*inner, *domain))
+
+
+def chosen(certificate: Certificate):
+    """The variant's conditions and level where I touches ∂D, else the main rule's."""
+    variant = certificate.variant_conditions()
+    if variant is not None and initial_reaches_boundary(certificate.spec):
+        return variant, certificate.variant_levels()
+    return certificate.conditions(), certificate.levels()
+
+
+def variant_level(name: str = "V", level: str = "beta") -> Level:
+    return Level(level, name, above=None, below="initial",
+                 text=f"β: just over the largest {name} on I")
+
+
 def roa_level(certificate: Certificate, name: str = "V", level: str = "beta",
               prefix: str = "") -> Level:
     # the smallest Ω that holds I: in discrete time the least to map into D; with
@@ -70,6 +115,16 @@ class RegionOfAttraction(Certificate):
     def levels(self):
         return (roa_level(self),)
 
+    def variant_conditions(self):
+        inward = inward_conditions(self)
+        return None if inward is None else inward + roa_conditions(self)[1:]
+
+    def variant_levels(self):
+        return (variant_level(),)
+
+    def chosen_conditions(self):
+        return chosen(self)
+
 
 # the ball round the origin whose V the first β must cover, as a share of the distance
 # from the origin to the edge of D's bounding box (the kernel raises β from there)
@@ -93,6 +148,9 @@ class LargestRegion(RegionOfAttraction):
     def levels(self):
         return (Level("beta", "V", above=None, below="initial",
                       text="β: just over the largest V on a small ball round the origin"),)
+
+    def variant_conditions(self):
+        return None  # the kernel's variant is for a region of attraction of a given I
 
     def starting_ball(self) -> Ball:
         low, high = self.spec.domain.bounding_box() or ((-1.0,) * len(self.spec.states),

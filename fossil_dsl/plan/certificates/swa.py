@@ -4,7 +4,8 @@ from __future__ import annotations
 from fossil_dsl.plan.certificates.barrier import DEFAULT_LAYERS as BARRIER_LAYERS
 from fossil_dsl.plan.certificates.barrier import barrier_conditions
 from fossil_dsl.plan.certificates.base import Certificate, register
-from fossil_dsl.plan.certificates.roa import DEFAULT_LAYERS, roa_conditions, roa_level
+from fossil_dsl.plan.certificates.roa import DEFAULT_LAYERS, chosen, inward_conditions, \
+    roa_conditions, roa_level, variant_level
 
 
 @register
@@ -18,9 +19,22 @@ class StableWhileAvoid(Certificate):
                 self.second_function("B", BARRIER_LAYERS, zero_at_origin=False))
 
     def conditions(self):
-        return roa_conditions(self) + barrier_conditions(
-            self, "B", self.role("initial"), self.role("unsafe"), "I", "U", prefix="barrier_")
+        return roa_conditions(self) + self._barrier()
 
     def levels(self):
         return (roa_level(self),)
+
+    def variant_conditions(self):
+        inward = inward_conditions(self)
+        return None if inward is None else inward + roa_conditions(self)[1:] + self._barrier()
+
+    def variant_levels(self):
+        return (variant_level(),)
+
+    def chosen_conditions(self):
+        return chosen(self)
+
+    def _barrier(self):
+        return barrier_conditions(self, "B", self.role("initial"), self.role("unsafe"), "I",
+                                  "U", prefix="barrier_")
 
