@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import time
 from fractions import Fraction
 
 import fossil_dsl
@@ -97,11 +98,23 @@ def test_the_neuron_is_certified_and_rechecked(tmp_path):
     result = fossil_dsl.synthesise(fossil_dsl.loads(NEURON), seed=0, timeout=60)
     assert result.certified, result.reason
     assert result.kernel.variant == INWARD
+    assert "quadratic V" in result.strategy  # the linearisation's, Ω reaching ∂D
     result.save(tmp_path)
     data = json.loads((tmp_path / "result.json").read_text())
     assert data["kernel"]["variant"] == INWARD
     checks = recheck(tmp_path, timeout=30)
     assert all(c.reproved for c in checks), [c for c in checks if not c.reproved]
+
+
+def test_a_quadratic_region_reaches_the_boundary_only_where_none_fits_inside():
+    from fossil_dsl.engine import quadratic_roa
+    found = list(quadratic_roa.candidates(compile_spec(fossil_dsl.loads(NEURON)),
+                                          time.monotonic() + 20))
+    assert found and all(f.reaches_boundary for f in found)
+    inside = NEURON.replace("box([-1, -0.5], [1, 0.5])", "box([-1, -1], [1, 1])")
+    found = list(quadratic_roa.candidates(compile_spec(fossil_dsl.loads(inside)),
+                                          time.monotonic() + 20))
+    assert found and not any(f.reaches_boundary for f in found)
 
 
 def test_an_equilibrium_on_the_face_is_not_certified():

@@ -22,7 +22,7 @@ from fossil_dsl.engine.loop import Cegis, CegisOutcome, as_listener
 from fossil_dsl.ir import traversal
 from fossil_dsl.kernel import Claim
 from fossil_dsl.engine.lemma_radius import lemma_radius
-from fossil_dsl.plan.compile import Plan, origin_radius, with_conditions
+from fossil_dsl.plan.compile import Plan, origin_radius, variant_plan
 from fossil_dsl.solvers.api import Backend
 from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES
 
@@ -76,7 +76,7 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
     note = "; ".join(n for n in notes if n)
     deadline += _learning_imported(plan)
     outcome = Cegis(plan, backend, listener, deadline).run()
-    variant = _variant_plan(plan) if verifier_only(plan) and not outcome.certified else None
+    variant = variant_plan(plan) if verifier_only(plan) and not outcome.certified else None
     if variant is not None:  # a given function may meet the variant's conditions instead
         other = Cegis(variant, backend, listener, deadline).run()
         if other.certified:
@@ -92,13 +92,6 @@ def _learning_imported(plan: Plan) -> float:
     before = torch_import.seconds_spent()
     torch_import.learning_support()
     return torch_import.seconds_spent() - before
-
-
-def _variant_plan(plan: Plan) -> Plan | None:
-    """The plan with the conditions of the kernel rule's variant, if it has one."""
-    conditions = plan.certificate.variant_conditions()
-    return None if conditions is None or tuple(conditions) == plan.conditions else \
-        with_conditions(plan, conditions, plan.certificate.variant_levels())
 
 
 def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
@@ -193,7 +186,8 @@ def _quadratic_region(plan: Plan, backend: Backend, listener, deadline: float):
     for index, finding in enumerate(itertools.islice(quadratic_roa.candidates(plan, budget),
                                                      QUADRATIC_TRIES)):
         larger = index == 0 and not all(map(traversal.is_arithmetic, plan.spec.dynamics))
-        found, note = _region_proved(plan, backend, listener, deadline, finding,
+        proved = variant_plan(plan) or plan if finding.reaches_boundary else plan
+        found, note = _region_proved(proved, backend, listener, deadline, finding,
                                      *(QUADRATIC_REFUTING if larger else
                                        (REACH_REFUTING_SECONDS, ATOMS_MAX_VARIABLES,
                                         SOS_QUERY_SECONDS)))
@@ -301,7 +295,7 @@ def _conserved(plan: Plan, backend: Backend, listener, deadline: float):
     (up to CONSERVED_REFINEMENTS times)."""
     listener.phase(0, "conserved quantities")
     budget = time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
-    variant = _variant_plan(plan) or plan
+    variant = variant_plan(plan) or plan
     extra, note = ([], []), "no conserved quantity separates I from U"
     for _ in range(CONSERVED_REFINEMENTS + 1):
         finding = first_integral.search(plan, budget, extra)

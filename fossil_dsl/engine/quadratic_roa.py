@@ -2,17 +2,17 @@
 from the Lyapunov equation of the linearised (with inputs, LQR-closed) system, and β
 just over V's largest value on I, the smallest sublevel set that holds I: the smaller
 Ω, the fewer states where dV/dt < 0 must hold. A (P, β) is a candidate where Ω lies in
-D (worked out for a box or ball) and V decreases at thousands of samples of Ω and of
+D (worked out for a box or ball; failing that, for a box D, where the field points into
+D on its faces: the kernel's variant) and V decreases at thousands of samples of Ω and
 its shell {V = β}; the decrease asked of P is Q = I, then random diagonal weights.
-
 The attempt is for `from I: stable` (no `region: largest`, which shapes V to the
 simulated basin) and `from I: stable and always not U`, with B = V - β where Ω misses U
 (Ω cannot be left, so {B <= 0} cannot either); for reach, RWA and RAR, V = k (x^T P x - β)
 falling by 10 γ at the samples (and RAR's B the same x^T P x's sublevel set just holding
 G, inside F). A learner whose level is halfway between I and ∂D, or whose margin is large
-against a small V, misses such a pair (probe53/n01, an excitable neuron: the
-Lyapunov equation's V holds at β = 1.05 times its largest value on I and fails at the
-halfway level). Nothing here is trusted: V and β are proved like any candidate.
+against a small V, misses such a pair (probe53/n01, an excitable neuron: the Lyapunov
+equation's V holds at 1.05 times its largest value on I, fails at the halfway level).
+Nothing here is trusted: V and β are proved like any candidate.
 """
 from __future__ import annotations
 
@@ -60,6 +60,7 @@ class QuadraticFinding:
     operating: np.ndarray
     levels: dict  # "beta" -> Fraction
     seconds: float
+    reaches_boundary: bool = False  # Ω meets ∂D: for the kernel's variant (inward_rules.py)
 
     def describe(self) -> str:
         control = " and a linear controller" if self.controller else ""
@@ -94,28 +95,37 @@ def candidates(plan: Plan, deadline: float):
     rng = np.random.default_rng(plan.options.seed)
     discrete = spec.time is TimeDomain.DISCRETE
     closed_loop, field = None, None
+    deferred, yielded = [], False  # Ω reaching ∂D: only where no Ω inside D passes
     for controller, gain, P in _shapes(plan, *found, operating, rng):
         if time.monotonic() > deadline:
-            return
+            break
         if controller is not closed_loop:  # (the weightings of one gain share it)
             closed_loop, field = controller, numeric_field(
                 [traversal.substitute(f, controller) for f in spec.dynamics], plan.states)
         shape = None if P is None else _exact_shape(P)
-        level = None if shape is None else _level(plan, shape)
-        if level is None or not _decreases(plan, field, shape, level, discrete, rng) \
+        level, reaching = (None, False) if shape is None else _level(plan, shape)
+        if level is None or not _decreases(plan, field, shape, level, discrete, rng, reaching) \
                 or not _misses_unsafe(plan, shape, level, rng):
             continue
         if plan.certificate.form in REACH_FORMS:
             formulas = _reach_formulas(plan, field, shape, level, discrete, rng)
             if formulas is not None:
+                yielded = True
                 yield QuadraticFinding(formulas, controller, gain, operating, {},
                                        time.monotonic() - started)
             continue
         V = _quadratic(shape, plan.states)
         formulas = {"V": V} if plan.certificate.form == FORMS[0] else \
             {"V": V, "B": E.add(V, E.Num(-level))}
-        yield QuadraticFinding(formulas, controller, gain, operating, {"beta": level},
-                               time.monotonic() - started)
+        finding = QuadraticFinding(formulas, controller, gain, operating, {"beta": level},
+                                   time.monotonic() - started, reaching)
+        if reaching:
+            deferred.append(finding)
+            continue
+        yielded = True
+        yield finding
+    if not yielded:
+        yield from deferred
 
 
 def _shapes(plan: Plan, A: np.ndarray, B: np.ndarray, operating: np.ndarray, rng):
@@ -194,10 +204,19 @@ def _floats(shape) -> np.ndarray:
     return np.array([[float(v) for v in row] for row in shape])
 
 
-def _level(plan: Plan, shape) -> Fraction | None:
-    """β just over an upper bound of V on I, where Ω = {V <= β} lies inside D by the
-    shapes' bounds (else None)."""
-    return _level_between(shape, plan.spec.property.role("initial"), plan.spec.domain)
+def _level(plan: Plan, shape) -> tuple[Fraction | None, bool]:
+    """(β just over an upper bound of V on I, whether Ω = {V <= β} reaches ∂D): Ω inside
+    D by the shapes' bounds, else reaching ∂D where the kernel's rule has a variant for
+    it (an asymmetric box D, as for a shifted population, holds no ellipsoid round the
+    origin that holds I: probe69/as10); else (None, False)."""
+    from fossil_dsl.engine.quadratic_shapes import set_ceiling
+    initial = plan.spec.property.role("initial")
+    level = _level_between(shape, initial, plan.spec.domain)
+    if level is not None or plan.certificate.form not in FORMS \
+            or plan.certificate.variant_conditions() is None:
+        return level, False
+    ceiling = set_ceiling(_floats(shape), initial, np.zeros(len(shape)))
+    return (None, False) if not ceiling else (Fraction(f"{ceiling * LEVEL_CUSHION:.3g}"), True)
 
 
 def _level_between(shape, inner, outer) -> Fraction | None:
@@ -229,10 +248,17 @@ def _misses_unsafe(plan: Plan, shape, level: Fraction, rng) -> bool:
     return bool(np.all(np.einsum("bi,ij,bj->b", points, P, points) > float(level)))
 
 
-def _decreases(plan: Plan, field, shape, level: Fraction, discrete: bool, rng) -> bool:
-    """V decreases (and, for a map, f(x) stays in D) at samples of Ω and of its shell."""
+def _decreases(plan: Plan, field, shape, level: Fraction, discrete: bool, rng,
+               reaching: bool = False) -> bool:
+    """V decreases (and, for a map, f(x) stays in D) at samples of Ω and of its shell;
+    where Ω reaches ∂D, at those in D, and the field points into D on D's faces."""
     P = _floats(shape)
     points = _ellipsoid_points(P, float(level), rng)
+    if reaching:
+        from fossil_dsl.engine.quadratic_shapes import enters_box
+        points = points[_inside(plan, plan.spec.domain, points)]
+        if not enters_box(plan.spec.domain, field, P, float(level), points):
+            return False
     change, image = _change(field, P, points, discrete)
     if discrete and not np.all(_inside(plan, plan.spec.domain, image)):
         return False

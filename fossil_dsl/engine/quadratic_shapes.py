@@ -291,3 +291,18 @@ def _numbers(region):
     if isinstance(region, S.Box):
         return low, high
     return (low + high) / 2, float(np.min(high - low)) / 2
+
+
+def enters_box(box_set, field, P: np.ndarray, level: float, points: np.ndarray) -> bool:
+    """The field points into the box at the sample points of {x^T P x <= level} moved
+    onto each of its faces (those still in the sublevel set)."""
+    low, high = box_set.bounding_box()
+    for i, end, side in ((i, end, side) for i in range(len(P))
+                         for end, side in ((low[i], 1.0), (high[i], -1.0))):
+        face = points.copy()
+        face[:, i] = end
+        face = face[np.einsum("bi,ij,bj->b", face, P, face) <= level]
+        with np.errstate(all="ignore"):
+            if len(face) and not np.all(side * field(face)[:, i] > 0):
+                return False
+    return True

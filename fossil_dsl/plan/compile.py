@@ -142,6 +142,14 @@ def with_conditions(plan: Plan, conditions, levels=None) -> Plan:
                    levels=plan.levels if levels is None else tuple(levels))
 
 
+def variant_plan(plan: Plan) -> Plan | None:
+    """The plan with the conditions of the kernel rule's variant, if it has one (and is
+    not already on it)."""
+    conditions = plan.certificate.variant_conditions()
+    return None if conditions is None or tuple(conditions) == plan.conditions else \
+        with_conditions(plan, conditions, plan.certificate.variant_levels())
+
+
 def origin_radius(spec: CheckedSpec) -> Fraction:
     """The ball a delta-decision verifier leaves out round the origin: ORIGIN_RADIUS, or
     a power of ten small enough that ten times it fits in the domain's box (the kernel
