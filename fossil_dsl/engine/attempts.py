@@ -13,7 +13,7 @@ import numpy as np
 from dataclasses import replace
 
 from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos, sos_reach,
-                               sos_roa, torch_import)
+                               sos_roa, swa_parts, torch_import)
 from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, budgets, only_function,
                                        prove_found, verify_given)
@@ -65,6 +65,8 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
                              (repelling.applies, _repelling),
                              (sos.applies, _sum_of_squares),
                              (quadratic_roa.applies, _quadratic_region),
+                             (swa_parts.applies, functools.partial(
+                                 swa_parts.attempt, prove=_region_proved)),
                              (sos_roa.applies, _region_sum_of_squares),
                              (sos_reach.applies, _reach_sum_of_squares),
                              (quadratic_roa.reaches, _quadratic_region)):
