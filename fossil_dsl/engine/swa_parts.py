@@ -70,8 +70,7 @@ def findings(plan: Plan, deadline: float):
         return
     region = _region_plan(plan)
     quadratic = itertools.islice(quadratic_roa.candidates(region, deadline), 1)
-    programs = (sos_roa.search(region, deadline) for _ in range(sos_roa.applies(region)))
-    for finding in itertools.chain(quadratic, programs):
+    for finding in itertools.chain(quadratic, _program(region, deadline)):
         if finding is None:
             continue
         yield PartsFinding({"V": finding.formulas["V"], "B": found.formula},
@@ -80,6 +79,12 @@ def findings(plan: Plan, deadline: float):
                            getattr(finding, "reaches_boundary", False),
                            f"V: {finding.describe()}; B: {found.describe()}",
                            getattr(finding, "stand_in", 0))
+
+
+def _program(region: Plan, deadline: float):
+    """The region-of-attraction program's finding (or None), only when asked for."""
+    if sos_roa.applies(region):
+        yield sos_roa.search(region, deadline)
 
 
 def _region_plan(plan: Plan) -> Plan:

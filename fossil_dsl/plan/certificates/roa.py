@@ -13,7 +13,7 @@ from fossil_dsl.ir.spec import Layer, TimeDomain
 DEFAULT_LAYERS = (Layer("square", 8),)
 # the forms whose certificate is a V with a sublevel set Ω in the region of attraction
 ROA_FORMS = ("region of attraction", "largest region of attraction")
-INWARD = "inward:"  # the names of the variant's conditions on D's faces
+FACE_PREFIX = "inward:"  # the names of the variant's conditions on D's faces
 
 
 def roa_conditions(certificate: Certificate, name: str = "V", level: str = "beta",
@@ -60,7 +60,7 @@ def inward_conditions(certificate: Certificate, name: str = "V",
             lower, upper = list(domain.lower), list(domain.upper)
             lower[i] = upper[i] = end
             found.append(Condition(
-                f"{INWARD}{state}:{side}", f"the field points into D on its face {state} = "
+                f"{FACE_PREFIX}{state}:{side}", f"the field points into D on its face {state} = "
                 f"{E.to_text(end)} where {name}(x) <= β", Box(tuple(lower), tuple(upper)),
                 L.Compare(relation, velocity_of(state), E.ZERO), guard=inside_level))
     return tuple(found)
