@@ -95,6 +95,17 @@ def negated_inward(formula: Formula) -> Formula:
     return disjunction(*parts) if isinstance(formula, And) else conjunction(*parts)
 
 
+def negations_inward(formula: Formula) -> Formula:
+    """The formula with every negation moved onto its comparisons (flipped): it is then
+    monotone in them, and a search meets the same comparison objects in every box."""
+    if isinstance(formula, Not):
+        return negations_inward(negated_inward(formula.arg))
+    if isinstance(formula, (And, Or)):
+        parts = [negations_inward(arg) for arg in formula.args]
+        return conjunction(*parts) if isinstance(formula, And) else disjunction(*parts)
+    return formula
+
+
 def open_inner(formula: Formula) -> Formula:
     """An open set inside the set that `formula` describes (all comparisons strict).
 

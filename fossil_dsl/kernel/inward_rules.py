@@ -31,13 +31,7 @@ SWA_INWARD_GUARANTEE = INWARD_GUARANTEE + (
 def literals(formula: L.Formula) -> list[L.Compare]:
     """The comparisons of `formula` with its negations moved onto them (D's description
     is then monotone in them: a comparison that turns true cannot take x out of D)."""
-    if isinstance(formula, L.Compare):
-        return [formula]
-    if isinstance(formula, L.Not):
-        return literals(L.negated_inward(formula.arg))
-    if isinstance(formula, (L.And, L.Or)):
-        return [c for arg in formula.args for c in literals(arg)]
-    return []
+    return list(L.comparisons(L.negations_inward(formula)))
 
 
 def points_inward(facts: Facts) -> None:

@@ -46,18 +46,10 @@ class ArbBackend:
         if any(lo > hi for lo, hi in box):  # bounds implied by conjuncts contradict
             return Answer(Status.UNSAT, solver=self.name)
         refuter = _Refuter(flint.arb, names)
-        return _search(refuter, _inward(formula), box, time.monotonic() + timeout, stop)
-
-
-def _inward(formula: L.Formula) -> L.Formula:
-    """The formula with every negation moved onto its comparisons, once: the search then
-    meets the same comparison objects in every box (their tables are kept by identity)."""
-    if isinstance(formula, L.Not):
-        return _inward(L.negated_inward(formula.arg))
-    if isinstance(formula, (L.And, L.Or)):
-        parts = [_inward(arg) for arg in formula.args]
-        return L.conjunction(*parts) if isinstance(formula, L.And) else L.disjunction(*parts)
-    return formula
+        # negations moved inward once: the search meets the same comparison objects in
+        # every box (their tables are kept by identity)
+        formula = L.negations_inward(formula)
+        return _search(refuter, formula, box, time.monotonic() + timeout, stop)
 
 
 def _search(refuter, formula, start, deadline: float, stop) -> Answer:

@@ -76,17 +76,19 @@ def initial_reaches_boundary(spec) -> bool:
     return any(a <= low or b >= high for a, b, low, high in zip(*inner, *domain))
 
 
-def chosen(certificate: Certificate):
-    """The variant's conditions and level where I touches ∂D, else the main rule's."""
-    variant = certificate.variant_conditions()
-    if variant is not None and initial_reaches_boundary(certificate.spec):
-        return variant, certificate.variant_levels()
-    return certificate.conditions(), certificate.levels()
+class ReachingBoundary:
+    """The kernel's variant for an Ω that reaches ∂D (kernel/inward_rules.py): β just
+    over V on I, and the variant's conditions learned where I touches ∂D."""
 
+    def variant_levels(self):
+        return (Level("beta", "V", above=None, below="initial",
+                      text="β: just over the largest V on I"),)
 
-def variant_level(name: str = "V", level: str = "beta") -> Level:
-    return Level(level, name, above=None, below="initial",
-                 text=f"β: just over the largest {name} on I")
+    def chosen_conditions(self):
+        variant = self.variant_conditions()
+        if variant is not None and initial_reaches_boundary(self.spec):
+            return variant, self.variant_levels()
+        return self.conditions(), self.levels()
 
 
 def roa_level(certificate: Certificate, name: str = "V", level: str = "beta",
@@ -101,7 +103,7 @@ def roa_level(certificate: Certificate, name: str = "V", level: str = "beta",
 
 
 @register
-class RegionOfAttraction(Certificate):
+class RegionOfAttraction(ReachingBoundary, Certificate):
     form = "region of attraction"
     title = "region-of-attraction certificate (Lyapunov function and sublevel set)"
     discrete_time = True
@@ -118,12 +120,6 @@ class RegionOfAttraction(Certificate):
     def variant_conditions(self):
         inward = inward_conditions(self)
         return None if inward is None else inward + roa_conditions(self)[1:]
-
-    def variant_levels(self):
-        return (variant_level(),)
-
-    def chosen_conditions(self):
-        return chosen(self)
 
 
 # the ball round the origin whose V the first β must cover, as a share of the distance

@@ -4,12 +4,12 @@ from __future__ import annotations
 from fossil_dsl.plan.certificates.barrier import DEFAULT_LAYERS as BARRIER_LAYERS
 from fossil_dsl.plan.certificates.barrier import barrier_conditions
 from fossil_dsl.plan.certificates.base import Certificate, register
-from fossil_dsl.plan.certificates.roa import DEFAULT_LAYERS, chosen, inward_conditions, \
-    roa_conditions, roa_level, variant_level
+from fossil_dsl.plan.certificates.roa import DEFAULT_LAYERS, ReachingBoundary, \
+    inward_conditions, roa_conditions, roa_level
 
 
 @register
-class StableWhileAvoid(Certificate):
+class StableWhileAvoid(ReachingBoundary, Certificate):
     form = "stable while avoid"
     title = "stable-while-avoid certificate (region of attraction V and barrier B)"
     discrete_time = True
@@ -27,12 +27,6 @@ class StableWhileAvoid(Certificate):
     def variant_conditions(self):
         inward = inward_conditions(self)
         return None if inward is None else inward + roa_conditions(self)[1:] + self._barrier()
-
-    def variant_levels(self):
-        return (variant_level(),)
-
-    def chosen_conditions(self):
-        return chosen(self)
 
     def _barrier(self):
         return barrier_conditions(self, "B", self.role("initial"), self.role("unsafe"), "I",
