@@ -12,6 +12,7 @@ import sympy
 
 import fossil_dsl
 from fossil_dsl.engine import sos_reach
+from fossil_dsl.engine.sos import interval_products
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
@@ -92,7 +93,7 @@ def test_a_box_gets_the_products_of_its_opposite_bounds_only():
     x = {(1, 0): 1}
     lower, upper = P.add(x, P.constant(1, 2)), P.add(P.scale(x, -1), P.constant(2, 2))
     other = {(0, 1): 1}
-    found = sos_reach.interval_products([lower, upper, other])
+    found = interval_products([lower, upper, other])
     assert found[:3] == [lower, upper, other] and len(found) == 4
     product = found[3]
     # (x + 1)(2 - x) >= 0 exactly on [-1, 2]
@@ -134,16 +135,18 @@ def test_a_safe_set_of_its_own_is_left_by_its_own_faces():
     assert result.certified and result.strategy.startswith("sum-of-squares"), result.summary()
 
 
-def test_a_set_that_is_no_conjunction_gives_no_program():
-    """A union of boxes for U: its constraints cannot be listed as one piece, and a
-    program over a wrong set would only waste the run's time."""
+def test_a_union_of_unsafe_boxes_is_asked_piece_by_piece():
+    """A union of boxes for U is no conjunction: before session 70 it gave no program;
+    V > 0 is now asked on each box within D (engine/sos.py `set_pieces`)."""
     import time
     union = DOUBLE_INTEGRATOR_RAR.replace("set unsafe = box([1.2, -2], [2, 2])",
                                           "set unsafe = box([1.2, -2], [2, 2]) | "
                                           "box([-2, 1.5], [2, 2])")
     plan = compile_spec(fossil_dsl.loads(union))
     assert sos_reach.applies(plan)
-    assert sos_reach.search(plan, time.monotonic() + 30) is None
+    assert sos_reach.search(plan, time.monotonic() + 30) is not None
+    result = fossil_dsl.synthesise(fossil_dsl.loads(union), timeout=60)
+    assert result.certified and result.kernel.certified
 
 
 GIVEN_RAR = """\
@@ -350,11 +353,13 @@ def test_a_map_with_sin_is_solved_for_a_polynomial_stand_in():
     assert sympy.Poly(V, *sorted(V.free_symbols, key=str)).total_degree() == 2
 
 
-def test_a_barrier_without_a_v_is_kept_and_v_learned_beside_it():
+def test_a_barrier_without_a_v_is_kept_and_v_learned_beside_it(monkeypatch):
     """probe59/ac08: the damping 1 + 0.5 (1 - exp(-x)) turns negative for x < -0.8, so no
     V decreases on all of D outside G (V's program is infeasible), but the barrier
     program finds B for the stand-in. B alone is returned, and the loop learns V with B
-    fixed (learning both failed in 120 s)."""
+    fixed (learning both failed in 120 s). Since session 70 V's program also asks
+    dV/dt <= λ V - γ, which finds V (test below): without it, as here, the path stays."""
+    monkeypatch.setattr(sos_reach, "GROWTH_RATES", ())
     spec = fossil_dsl.load(ROOT / "specs" / "probe59" / "ac08_exp_focus_rar.fsl")
     finding = sos_reach.search(compile_spec(spec), time.monotonic() + 30)
     assert finding is not None and finding.degree == 0 and set(finding.formulas) == {"B"}
@@ -367,6 +372,17 @@ def test_a_barrier_without_a_v_is_kept_and_v_learned_beside_it():
     difference = sympy.Poly(result.sympy["B"] - to_sympy(finding.formulas["B"], symbols),
                             *symbols.values())
     assert max(abs(float(c)) for c in difference.coeffs()) < 1e-3
+
+
+def test_with_a_growth_rate_the_program_finds_v_beside_b():
+    """ac08 again: dV/dt <= λ V - γ asks the decrease only where V <= 0, so the
+    program's V of degree 6 serves with its B (5 s in all)."""
+    spec = fossil_dsl.load(ROOT / "specs" / "probe59" / "ac08_exp_focus_rar.fsl")
+    finding = sos_reach.search(compile_spec(spec), time.monotonic() + 30)
+    assert finding is not None and finding.degree == 6 and set(finding.formulas) == {"V", "B"}
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares"), result.strategy
 
 
 def test_a_stand_in_finding_gets_longer_solver_queries():

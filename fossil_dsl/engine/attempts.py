@@ -13,8 +13,8 @@ import numpy as np
 from dataclasses import replace
 
 from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos, sos_reach,
-                               sos_roa, swa_parts, torch_import)
-from fossil_dsl.engine.given import verifier_only
+                               sos_roa, swa_parts)
+from fossil_dsl.engine.learning import learn, learning_imported
 from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, budgets, only_function,
                                        prove_found, verify_given)
 from fossil_dsl.engine.sos_barrier import barrier
@@ -76,24 +76,7 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
                 return found
             notes.append(note)
     note = "; ".join(n for n in notes if n)
-    deadline += _learning_imported(plan)
-    outcome = Cegis(plan, backend, listener, deadline).run()
-    variant = variant_plan(plan) if verifier_only(plan) and not outcome.certified else None
-    if variant is not None:  # a given function may meet the variant's conditions instead
-        other = Cegis(variant, backend, listener, deadline).run()
-        if other.certified:
-            return variant, replace(other, strategy="given function")
-    return plan, replace(outcome, strategy="learning" + (f" ({note})" if note else ""))
-
-
-def _learning_imported(plan: Plan) -> float:
-    """Seconds spent importing torch for the loop's learning (0 where it learns nothing,
-    or torch was in already): start-up, which the loop's deadline is moved on by."""
-    if verifier_only(plan):
-        return 0.0
-    before = torch_import.seconds_spent()
-    torch_import.learning_support()
-    return torch_import.seconds_spent() - before
+    return learn(plan, backend, listener, deadline, note)
 
 
 def _shaped_to_basin(plan: Plan, backend: Backend, listener, deadline: float):
@@ -284,7 +267,7 @@ def _learned_beside(plan: Plan, backend: Backend, listener, deadline: float, fin
     given = replace(plan, functions=tuple(replace(f, candidate=finding.formulas.get(f.name))
                                           for f in plan.functions))
     until = time.monotonic() + LEARNED_BESIDE_SHARE * (deadline - time.monotonic())
-    outcome = Cegis(given, backend, listener, until + _learning_imported(given)).run()
+    outcome = Cegis(given, backend, listener, until + learning_imported(given)).run()
     if outcome.certified:
         return (given, replace(outcome, strategy=f"learning V for {finding.describe()}")), ""
     return None, f"{finding.describe()}: no V learned for it: {outcome.reason}"

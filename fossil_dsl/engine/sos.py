@@ -23,6 +23,7 @@ from fractions import Fraction
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.sets import Named, Union
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
 from fossil_dsl.solvers.sdp import Program
@@ -146,6 +147,17 @@ def set_constraints(region, states, exact: bool = False) -> list[P.Polynomial]:
             if exact:
                 raise Inexact(str(exc)) from exc
     return found
+
+
+def set_pieces(region, states, exact: bool = False) -> list[list[P.Polynomial]]:
+    """The constraints of each member of a union (of unions), as set_constraints gives
+    them: a condition asked on a union is asked on each member (probe70/at23: I two
+    boxes, one each side of the origin)."""
+    if isinstance(region, Named):
+        return set_pieces(region.value, states, exact)
+    if isinstance(region, Union):
+        return set_pieces(region.left, states, exact) + set_pieces(region.right, states, exact)
+    return [set_constraints(region, states, exact)]
 
 
 def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:

@@ -22,9 +22,8 @@ from fractions import Fraction
 
 from fossil_dsl.engine.polynomial_field import exact_field, padded, widened
 from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, interval_products, rounded,
-                                   set_constraints)
+                                   set_constraints, set_pieces)
 from fossil_dsl.ir import polynomials as P
-from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
@@ -51,11 +50,12 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
     # has; the products (x - l)(u - x) >= 0 bring the -x^2 terms (probe61/ag03, a
     # 6-state chain of masses with tanh friction: a quadratic B, else none). D's products
     # made the flow condition's programs larger for nothing (probe61/af11: 0.4 -> 2 s)
-    domain = padded(set_constraints(plan.spec.domain, states), n) + facts
-    initial = padded(interval_products(
-        set_constraints(plan.spec.property.role("initial"), states)), n)
-    unsafe = padded(set_constraints(Intersection(plan.spec.property.role("unsafe"),
-                                                  plan.spec.domain), states), n)
+    plain_domain = set_constraints(plan.spec.domain, states)
+    domain = padded(plain_domain, n) + facts
+    initial = [padded(interval_products(piece), n)
+               for piece in set_pieces(plan.spec.property.role("initial"), states)]
+    unsafe = [padded(piece + plain_domain, n)
+              for piece in set_pieces(plan.spec.property.role("unsafe"), states)]
     # with facts, a quadratic B only, from small programs: those of higher degree gave
     # tiny margins (a05: degree 6, 5 s lost) or B's the kernel's refutations (at most
     # ATOMS_MAX_VARIABLES) could not prove (s12: degree 4, 8 s), and programs with many
@@ -64,7 +64,7 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
         for mu in DECAY_RATES:
             if time.monotonic() > deadline:
                 return None
-            program = BarrierProgram(n, field.numerators, initial, [unsafe], domain, degree,
+            program = BarrierProgram(n, field.numerators, initial, unsafe, domain, degree,
                                      mu, field.denominator, len(states))
             largest = ATOMS_MAX_VARIABLES if facts else \
                 MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES
@@ -84,9 +84,10 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
 
 
 class BarrierProgram(Program):
-    """The identities above; U given as pieces (constraint lists), B > 0 on each."""
+    """The identities above; I and U given as pieces (constraint lists), B < 0 on each
+    of I's, B > 0 on each of U's."""
 
-    def __init__(self, n: int, field, initial, unsafe_pieces, domain, degree: int,
+    def __init__(self, n: int, field, initial_pieces, unsafe_pieces, domain, degree: int,
                  mu: float, denominator: P.Polynomial | None = None,
                  states: int | None = None):
         super().__init__(n, searches=True)
@@ -96,8 +97,9 @@ class BarrierProgram(Program):
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))
         b_terms = [{m: Fraction(1)} for m in self.basis]
-        self._condition([(v, P.scale(t, -1)) for v, t in zip(self.coefficients, b_terms)],
-                        initial)
+        for piece in initial_pieces:
+            self._condition([(v, P.scale(t, -1)) for v, t in zip(self.coefficients, b_terms)],
+                            piece)
         for piece in unsafe_pieces:
             self._condition(list(zip(self.coefficients, b_terms)), piece)
         # multiplied through by the field's denominator Q > 0 (1 for a polynomial field):

@@ -10,16 +10,17 @@ fixed beforehand to an LQR gain of its linearisation, rounded as the verifier wi
 
 V (a polynomial of degree 2 or 4, coefficients in [-100, 100]) and the largest e with
 
-    -V - e          >= 0  on I
-     V - e          >= 0  on each face of D, and on D outside the interior of S
-    -dV/dt - γ - e  >= 0  on D outside the interior of G
+    -V - e                >= 0  on each member of I (a union's, each)
+     V - e                >= 0  on each face of D, and on D outside the interior of S
+    -dV/dt + λ V - γ - e  >= 0  on D outside the interior of G
 
 each a Positivstellensatz identity (a sum of squares plus sum-of-squares multiples of the
 set's constraints; "outside a set's interior" is one piece per constraint g >= 0 of the
-set, where g <= 0). The last asks dV/dt <= -γ even where V > 0, which is stronger than the
-condition but keeps the program linear in V; V's sublevel set {V <= 0} may lie anywhere,
-so it need not be centred at the origin (an I on one side of G, an unsafe set on the
-other: no ellipsoid round the origin fits between them). For RAR, B (degree 2, then 4)
+set, where g <= 0). With λ = 0 the last asks dV/dt <= -γ even where V > 0, which no V
+meets where D outside G holds another equilibrium; then λ > 0 (V of degree up to 6):
+dV/dt <= λ V - γ, the condition itself where V <= 0, still linear in V. {V <= 0} may
+lie anywhere, so it need not be centred at the origin (an I on one side of G, an unsafe
+set on the other: no ellipsoid round the origin fits between them). For RAR, B (degree 2, then 4)
 comes from the barrier program (sos_barrier.py) with G for I and the part of D outside F
 for U; where V's program fails, B alone is returned, and V is learned beside it.
 
@@ -37,13 +38,13 @@ import numpy as np
 from fossil_dsl.engine.linear import operating_point
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.sos import Inexact, faces, interval_products, rounded, set_constraints
+from fossil_dsl.engine.reach_pieces import Pieces
+from fossil_dsl.engine.sos import Inexact, rounded
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
 from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
-from fossil_dsl.ir.sets import Complement, Intersection
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.rwa import GAMMA
 from fossil_dsl.plan.compile import Plan, default_synthesis
@@ -54,6 +55,10 @@ from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 FORMS = ("reach while avoid", "reach", "reach-avoid-remain", "reach and stay while avoid")
 DISCRETE_FORMS = ("reach while avoid", "reach", "reach and stay while avoid")
 HALF_DEGREES = (1, 2)  # V of degree 2, then 4
+# where no V decreases on all of D outside G (another equilibrium there: the rest state
+# of probe68/ar15's neuron), dV <= λ V - γ: a decrease only where V <= 0, still linear
+GROWTH_RATES = (1.0, 0.2)
+GROWING_HALF_DEGREES = (1, 2, 3)  # ar15: degree 6 (margin 1 at λ = 1; none of degree 4)
 STAND_IN_DEGREES, MAP_STAND_IN_DEGREES = (3, 5, 7), (3, 5)
 # LQR gains tried with a stand-in, at most: where it works the first or second gain did
 STAND_IN_CONTROLLERS = 3  # (19 specs with inputs; probe36/r01's eight programs took 8.5 s)
@@ -118,7 +123,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     if operating is None:
         return None
     try:
-        pieces = _Pieces(plan)
+        pieces = Pieces(plan)
     except Inexact:
         return None
     rng = np.random.default_rng(plan.options.seed)
@@ -145,7 +150,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     return None
 
 
-def _over_denominator(closed, plan: Plan, pieces: _Pieces, discrete: bool):
+def _over_denominator(closed, plan: Plan, pieces: Pieces, discrete: bool):
     """(N, Q, the stand-in's degree) for a system that is not polynomial: an ODE's
     rational field over one denominator Q > 0 (the programs are multiplied through by Q;
     RAR's barrier program is for polynomial fields), else a polynomial stand-in over
@@ -180,91 +185,7 @@ def _polynomial(expressions, variables):
         return None
 
 
-def _constraints(region, states) -> list[P.Polynomial]:
-    """The region's constraints, exactly: a program's condition on a larger set than
-    "outside S" or "G" would ask for the wrong thing."""
-    return set_constraints(region, states, exact=True)
-
-
-class _Pieces:
-    """The constraint lists (g >= 0 on the piece) of every condition's sets; raises
-    Inexact where a set is not described exactly."""
-
-    def __init__(self, plan: Plan):
-        spec, states = plan.spec, plan.states
-        prop = spec.property
-        self.domain = _constraints(spec.domain, states)
-        self.initial = interval_products(_constraints(prop.role("initial"), states))
-        unsafe = prop.role("unsafe")
-        if prop.form == "reach":  # S is D
-            outside_safe = []
-        elif unsafe is not None and not isinstance(unsafe, Complement):  # S = D \ U
-            outside_safe = [interval_products(
-                _constraints(Intersection(unsafe, spec.domain), states))]
-        else:  # S is a set of its own (`S until G`)
-            outside_safe = self.outside(prop.role("safe"), states)
-        self.boundary = self.faces() + outside_safe
-        staying = prop.form == "reach and stay while avoid"
-        goal = prop.role("final") if staying else prop.role("goal")
-        self.outside_goal = self.outside(goal, states)
-        self.goal = interval_products(_constraints(goal, states))
-        final = prop.role("final")
-        self.outside_final = self.outside(final, states) if final is not None and \
-            not staying else None
-        self.stay = _StayPieces(self, goal, plan) if staying else None
-
-    def faces(self) -> list[list[P.Polynomial]]:
-        return faces(self.domain)
-
-    def outside(self, region, states) -> list[list[P.Polynomial]]:
-        """D outside the region's interior: {g <= 0} within D, one piece per g."""
-        return [[P.scale(g, -1)] + interval_products(self.domain)
-                for g in _constraints(region, states)]
-
-
-class _StayPieces:
-    """For RSWA, balls round the origin (the closed loop's equilibrium) inside F, of a
-    quarter and a half of the sampled distance to F's boundary: V < β on the inner
-    one, V > β on F outside the outer one, and V decreases on D outside the inner one.
-    With β fixed, F ∩ {V >= β} then lies where V decreases and ∂F has V > β. For a map,
-    V(f(x)) < β on the inner ball too: a step from F ∩ {V <= β} then keeps V <= β."""
-
-    def __init__(self, pieces: _Pieces, final, plan: Plan):
-        states = plan.states
-        reach = _distance_to_boundary(final, plan)
-        if reach is None:
-            raise Inexact("the origin is not inside F")
-        inner, outer = (_ball(states, reach / 4), _ball(states, reach / 2))
-        self.inner = [inner]
-        self.decrease = [[P.scale(inner, -1)] + interval_products(pieces.domain)]
-        self.above = [pieces.goal + [P.scale(outer, -1)]]
-
-
-def _ball(states, radius: float) -> P.Polynomial:
-    """r^2 - |x|^2 (>= 0 on the ball), with r^2 a short rational."""
-    square = Fraction(radius ** 2).limit_denominator(10 ** 6)
-    return P.add(P.constant(square, len(states)),
-                 P.scale(P.polynomial(E.squared_norm(states), states), -1))
-
-
-def _distance_to_boundary(region, plan: Plan) -> float | None:
-    """The smallest |x| over samples of the region's boundary, where the origin lies in
-    the region (else None)."""
-    from fossil_dsl.engine.evaluate import holds, state_env
-    from fossil_dsl.engine.sampling import sample
-    from fossil_dsl.ir.sets import Boundary
-    states = plan.states
-    origin = np.zeros((1, len(states)))
-    if not holds(region.contains_formula(states), state_env(states, origin), 1)[0]:
-        return None
-    points = np.asarray(sample(Boundary(region), states, 2000,
-                               np.random.default_rng(plan.options.seed),
-                               plan.spec.domain.bounding_box()), dtype=float)
-    distance = float(np.linalg.norm(points, axis=1).min()) if len(points) else 0.0
-    return distance if distance > 0 else None
-
-
-def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
+def _functions(n: int, field, denominator, pieces: Pieces, deadline: float,
                discrete: bool, partial: bool = False):
     """({"V": V, "B": B for RAR}, levels, V's degree, margin) or None; the field is
     field / denominator (denominator > 0 on D), or the map (`discrete`). Where
@@ -275,12 +196,12 @@ def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
         b = _barrier(n, field, pieces, deadline)
         if b is None:
             return None
-    for half in HALF_DEGREES:
+    for rate, half in _shapes(pieces):
         if time.monotonic() > deadline:
             return None
-        program = _ReachProgram(n, field, denominator, pieces, half, discrete)
+        program = _ReachProgram(n, field, denominator, pieces, half, discrete, rate)
         if program.count > MAX_VARIABLES:
-            return None
+            continue
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
             found = {"V": program.exact_v(x)}
@@ -290,13 +211,22 @@ def _functions(n: int, field, denominator, pieces: _Pieces, deadline: float,
     return ({"B": b}, {}, 0, 0.0) if partial and b is not None else None
 
 
-def _barrier(n: int, field, pieces: _Pieces, deadline: float):
+def _shapes(pieces: Pieces) -> list[tuple[float, int]]:
+    """(λ, half-degree) of V's programs in turn: decrease on all of D outside G, then
+    (not for RSWA, whose decrease pieces are its own) only where V <= 0."""
+    shapes = [(0.0, half) for half in HALF_DEGREES]
+    if pieces.stay is None:
+        shapes += [(rate, half) for half in GROWING_HALF_DEGREES for rate in GROWTH_RATES]
+    return shapes
+
+
+def _barrier(n: int, field, pieces: Pieces, deadline: float):
     """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B on D, of degree 2, then 4 (a
     hardening spring's x^3 outgrows every quadratic's decay on D: probe54/o07); or None."""
     for half, mu in itertools.product(HALF_DEGREES, DECAY_RATES):
         if time.monotonic() > deadline:
             return None
-        program = BarrierProgram(n, field, pieces.goal, pieces.outside_final, pieces.domain,
+        program = BarrierProgram(n, field, [pieces.goal], pieces.outside_final, pieces.domain,
                                  half, mu)
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
@@ -305,8 +235,8 @@ def _barrier(n: int, field, pieces: _Pieces, deadline: float):
 
 
 class _ReachProgram(Program):
-    def __init__(self, n: int, field, denominator, pieces: _Pieces, half: int,
-                 discrete: bool):
+    def __init__(self, n: int, field, denominator, pieces: Pieces, half: int,
+                 discrete: bool, rate: float = 0.0):
         super().__init__(n, searches=True)
         self.basis = P.monomials(n, 0, 2 * half)
         self.coefficients = self.unknown_polynomial(self.basis, BOUND)
@@ -314,12 +244,16 @@ class _ReachProgram(Program):
         self.at_most.append(({self.margin: 1.0}, 1.0))
         terms = [{m: Fraction(1)} for m in self.basis]
         negated = [(v, P.scale(t, -1)) for v, t in zip(self.coefficients, terms)]
-        self.require(negated, pieces.initial)
+        for piece in pieces.initial:
+            self.require(negated, piece)
         for piece in pieces.boundary:
             self.require(list(zip(self.coefficients, terms)), piece)
-        decrease = [(v, P.scale(P.change(t, field, discrete), -1))
+        # grad V . N <= -γ Q, that is dV/dt <= -γ (for a map V(f(x)) - V(x) <= -γ); with
+        # a rate λ, grad V . N <= (λ V - γ) Q: the same where V <= 0
+        growth = Fraction(rate).limit_denominator(1000)
+        decrease = [(v, P.add(P.scale(P.change(t, field, discrete), -1),
+                              P.scale(P.multiply(t, denominator), growth)))
                     for v, t in zip(self.coefficients, terms)]
-        # grad V . N <= -γ Q, that is dV/dt <= -γ (for a map V(f(x)) - V(x) <= -γ)
         stay = pieces.stay
         for piece in pieces.outside_goal if stay is None else stay.decrease:
             self.require(decrease, piece, P.scale(denominator, -GAMMA))

@@ -48,7 +48,7 @@ from fossil_dsl.engine.linear import jacobians, operating_point
 from fossil_dsl.engine.polynomial_field import PolynomialField, exact_field, padded, widened
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.sos import (Inexact, faces, interval_products, rounded, set_constraints,
-                                   squared_norm)
+                                   set_pieces, squared_norm)
 from fossil_dsl.engine.sos_reach import BOUND, DECIMALS, MIN_MARGIN, ReachFinding
 from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import polynomials as P
@@ -177,12 +177,12 @@ def _closed_loop(plan: Plan, closed, discrete: bool) -> PolynomialField | None:
 
 
 def _sets(plan: Plan):
-    """(D's constraints, I's with its boxes' products), or None where either is not a
-    conjunction of polynomial comparisons."""
+    """(D's constraints, each member of I's with its boxes' products), or None where D
+    or a member of I is not a conjunction of polynomial comparisons."""
     try:
         return (set_constraints(plan.spec.domain, plan.states, exact=True),
-                interval_products(set_constraints(plan.spec.property.role("initial"),
-                                                  plan.states, exact=True)))
+                [interval_products(piece) for piece in set_pieces(
+                    plan.spec.property.role("initial"), plan.states, exact=True)])
     except Inexact:
         return None
 
@@ -204,7 +204,8 @@ class _RegionProgram(Program):
         one = P.constant(1, n)
         inside = padded(interval_products(domain), n)
         self.require_nonnegative(v, inside, (self.margin, norm))
-        self.require_nonnegative(minus_v, padded(initial, n), (self.margin, one), one)
+        for piece in initial:
+            self.require_nonnegative(minus_v, padded(piece, n), (self.margin, one), one)
         for face in faces(domain):
             self.require_nonnegative(v, padded(face, n), (self.margin, one), P.scale(one, -1))
         # over N = f Q with Q > 0: -grad V . N >= e|x|^2 gives dV/dt <= -e|x|^2 / Q

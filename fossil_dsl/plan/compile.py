@@ -150,6 +150,21 @@ def variant_plan(plan: Plan) -> Plan | None:
         with_conditions(plan, conditions, plan.certificate.variant_levels())
 
 
+def richer_plan(plan: Plan) -> Plan | None:
+    """The plan with each function of the compiler's quadratic template (`square(w)`)
+    given a quartic one (`poly4(w)`), for a second learning run where the first gave up:
+    no quadratic V reaches a goal round an equilibrium off the origin when I is far on
+    one side and D's boundary near on the other (probe70/at17). None where the user chose
+    the templates, or none is quadratic."""
+    if not default_synthesis(plan):
+        return None
+    functions = tuple(replace(f, layers=tuple(Layer("poly4", layer.width)
+                                              if layer.activation == "square" else layer
+                                              for layer in f.layers))
+                      for f in plan.functions)
+    return None if functions == plan.functions else replace(plan, functions=functions)
+
+
 def origin_radius(spec: CheckedSpec) -> Fraction:
     """The ball a delta-decision verifier leaves out round the origin: ORIGIN_RADIUS, or
     a power of ten small enough that ten times it fits in the domain's box (the kernel

@@ -1,0 +1,99 @@
+"""The sets of the reach programs (sos_reach.py) as constraint lists, g >= 0 on each
+piece: I's members, D's faces and the part of D outside S, D outside G (and F), and for
+RSWA the balls round the origin inside F that fix its level."""
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+
+from fossil_dsl.engine.sos import Inexact, faces, interval_products, set_constraints, set_pieces
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.sets import Complement
+from fossil_dsl.plan.compile import Plan
+
+
+def _constraints(region, states) -> list[P.Polynomial]:
+    """The region's constraints, exactly: a program's condition on a larger set than
+    "outside S" or "G" would ask for the wrong thing."""
+    return set_constraints(region, states, exact=True)
+
+
+class Pieces:
+    """The constraint lists (g >= 0 on the piece) of every condition's sets; raises
+    Inexact where a set is not described exactly."""
+
+    def __init__(self, plan: Plan):
+        spec, states = plan.spec, plan.states
+        prop = spec.property
+        self.domain = _constraints(spec.domain, states)
+        self.initial = [interval_products(piece)
+                        for piece in set_pieces(prop.role("initial"), states, exact=True)]
+        unsafe = prop.role("unsafe")
+        if prop.form == "reach":  # S is D
+            outside_safe = []
+        elif unsafe is not None and not isinstance(unsafe, Complement):  # S = D \ U
+            outside_safe = [interval_products(piece + self.domain)
+                            for piece in set_pieces(unsafe, states, exact=True)]
+        else:  # S is a set of its own (`S until G`)
+            outside_safe = self.outside(prop.role("safe"), states)
+        self.boundary = self.faces() + outside_safe
+        staying = prop.form == "reach and stay while avoid"
+        goal = prop.role("final") if staying else prop.role("goal")
+        self.outside_goal = self.outside(goal, states)
+        self.goal = interval_products(_constraints(goal, states))
+        final = prop.role("final")
+        self.outside_final = self.outside(final, states) if final is not None and \
+            not staying else None
+        self.stay = StayPieces(self, goal, plan) if staying else None
+
+    def faces(self) -> list[list[P.Polynomial]]:
+        return faces(self.domain)
+
+    def outside(self, region, states) -> list[list[P.Polynomial]]:
+        """D outside the region's interior: {g <= 0} within D, one piece per g."""
+        return [[P.scale(g, -1)] + interval_products(self.domain)
+                for g in _constraints(region, states)]
+
+
+class StayPieces:
+    """For RSWA, balls round the origin (the closed loop's equilibrium) inside F, of a
+    quarter and a half of the sampled distance to F's boundary: V < β on the inner
+    one, V > β on F outside the outer one, and V decreases on D outside the inner one.
+    With β fixed, F ∩ {V >= β} then lies where V decreases and ∂F has V > β. For a map,
+    V(f(x)) < β on the inner ball too: a step from F ∩ {V <= β} then keeps V <= β."""
+
+    def __init__(self, pieces: Pieces, final, plan: Plan):
+        states = plan.states
+        reach = _distance_to_boundary(final, plan)
+        if reach is None:
+            raise Inexact("the origin is not inside F")
+        inner, outer = (_ball(states, reach / 4), _ball(states, reach / 2))
+        self.inner = [inner]
+        self.decrease = [[P.scale(inner, -1)] + interval_products(pieces.domain)]
+        self.above = [pieces.goal + [P.scale(outer, -1)]]
+
+
+def _ball(states, radius: float) -> P.Polynomial:
+    """r^2 - |x|^2 (>= 0 on the ball), with r^2 a short rational."""
+    square = Fraction(radius ** 2).limit_denominator(10 ** 6)
+    return P.add(P.constant(square, len(states)),
+                 P.scale(P.polynomial(E.squared_norm(states), states), -1))
+
+
+def _distance_to_boundary(region, plan: Plan) -> float | None:
+    """The smallest |x| over samples of the region's boundary, where the origin lies in
+    the region (else None)."""
+    from fossil_dsl.engine.evaluate import holds, state_env
+    from fossil_dsl.engine.sampling import sample
+    from fossil_dsl.ir.sets import Boundary
+    states = plan.states
+    origin = np.zeros((1, len(states)))
+    if not holds(region.contains_formula(states), state_env(states, origin), 1)[0]:
+        return None
+    points = np.asarray(sample(Boundary(region), states, 2000,
+                               np.random.default_rng(plan.options.seed),
+                               plan.spec.domain.bounding_box()), dtype=float)
+    distance = float(np.linalg.norm(points, axis=1).min()) if len(points) else 0.0
+    return distance if distance > 0 else None
