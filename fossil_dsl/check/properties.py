@@ -57,8 +57,10 @@ FORMS: list[PropertyForm] = [
     PropertyForm("stable while avoid", "ROA + barrier", "stable and always not U",
                  stable_type=True, max_iters=100, functions=2,
                  relations=(("inside", "initial", "domain"), ("disjoint", "initial", "unsafe"))),
+    # reaching G asks no equilibrium of the controller (its bias may hold the state
+    # anywhere, a tank's level at its set point: probe70/at27), so G need not hold 0
     PropertyForm("reach while avoid", "reach-while-avoid", "not U until G",
-                 relations=_INTERIOR, origin_roles=("goal",)),
+                 relations=_INTERIOR),
     PropertyForm("reach and stay while avoid", "RWA + stay level set",
                  "not U until always F",
                  relations=(("inside_interior", "initial", "safe"),
@@ -70,7 +72,7 @@ FORMS: list[PropertyForm] = [
                                         ("disjoint", "final", "unsafe")),
                  origin_roles=("goal", "final")),
     PropertyForm("reach", "RWA with the safe set = the domain", "eventually G",
-                 relations=_INTERIOR, origin_roles=("goal",)),
+                 relations=_INTERIOR),
 ]
 
 

@@ -40,15 +40,17 @@ def lqr_gains(spec, controlled: bool, operating, rng, state=None):
             yield found
 
 
-def lqr_controllers(plan, operating: np.ndarray, rng):
+def lqr_controllers(plan, operating: np.ndarray, rng, centre=None):
     """(input -> exact formula, -K) for each LQR gain (rounded to the digits the
-    verifier sees), or one ({}, None) without inputs."""
+    verifier sees), or one ({}, None) without inputs; with a `centre` c (an equilibrium
+    for the inputs `operating`), u = -K (x - c) + operating."""
     spec = plan.spec
     if not spec.inputs:
         yield {}, None
         return
-    for _, K in lqr_gains(spec, True, operating, rng):
-        yield exact_controller(spec, -K, operating, plan.options.digits)
+    for _, K in lqr_gains(spec, True, operating, rng, centre):
+        bias = operating if centre is None else operating + K @ centre
+        yield exact_controller(spec, -K, bias, plan.options.digits)
 
 
 def exact_controller(spec, gain: np.ndarray, operating: np.ndarray, digits: int):

@@ -97,3 +97,19 @@ def _distance_to_boundary(region, plan: Plan) -> float | None:
                                plan.spec.domain.bounding_box()), dtype=float)
     distance = float(np.linalg.norm(points, axis=1).min()) if len(points) else 0.0
     return distance if distance > 0 else None
+
+
+def set_point(plan: Plan) -> np.ndarray | None:
+    """Where a controller should hold the state when G (F for RSWA) lies off the origin:
+    the middle of G's box, where that is in G (a tank's level: probe70/at27); None where
+    the origin is in G, or the middle is not."""
+    from fossil_dsl.engine.evaluate import holds, state_env
+    prop = plan.spec.property
+    goal = prop.role("final") if prop.form == "reach and stay while avoid" else prop.role("goal")
+    box = goal.bounding_box() if goal is not None else None
+    if box is None:
+        return None
+    points = np.array([np.zeros(len(plan.states)),
+                       (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2])
+    inside = holds(goal.contains_formula(plan.states), state_env(plan.states, points), 2)
+    return points[1] if inside[1] and not inside[0] else None

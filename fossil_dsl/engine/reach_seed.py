@@ -47,17 +47,19 @@ def candidates(plan, networks: dict, controller, samples: dict) -> list:
     no seed applies."""
     if plan.spec.property.form not in REACH_FORMS or not _fits(plan, networks, controller):
         return []
-    operating = operating_point(plan.spec)
-    if operating is None or not _origin_in_goal(plan):
+    in_goal = _origin_in_goal(plan)
+    operating = operating_point(plan.spec) if in_goal else None
+    movable = controller is not None and not _zero_at_origin(networks, controller)
+    if operating is None and not movable:
         return []
     rng = np.random.default_rng(plan.options.seed)
     boundary = samples.get("boundary")
     if boundary is None:  # discrete time has no condition on ∂S; the ellipsoid must fit
         boundary = _boundary_samples(plan, rng)
-    found = _fitting(plan, networks, samples, boundary, np.zeros(len(plan.states)),
-                     operating, rng)
-    for centre in ([] if found or controller is None or _zero_at_origin(networks, controller)
-                   else _goal_centres(plan, samples.get("initial"))):
+    found = [] if operating is None else _fitting(
+        plan, networks, samples, boundary, np.zeros(len(plan.states)), operating, rng)
+    for centre in ([] if found or not movable
+                   else _goal_centres(plan, samples.get("initial"), in_goal)):
         shifted = operating_point(plan.spec, centre)
         if shifted is not None:
             found = _fitting(plan, networks, samples, boundary, centre, shifted, rng)
@@ -96,19 +98,27 @@ def _fitting(plan, networks: dict, samples: dict, boundary, centre, operating, r
 CENTRE_SHARES = (0.5, 0.25)  # of G's extent from the origin towards I, in turn
 
 
-def _goal_centres(plan, initial) -> list[np.ndarray]:
-    """Points of G on the segment from the origin towards the middle of I (of its box:
-    the samples' mean has stray components, and a pendulum's state with a velocity is no
-    equilibrium for any input), at CENTRE_SHARES of the distance to G's boundary there."""
+def _goal_centres(plan, initial, from_origin: bool = True) -> list[np.ndarray]:
+    """Points of G on the segment from the origin (else from the middle of G's box, and
+    that middle first: a set point such as a tank's level) towards the middle of I (of its
+    box: the samples' mean has stray components, and a pendulum's state with a velocity
+    is no equilibrium for any input), at CENTRE_SHARES of the distance to G's boundary."""
     towards = initial_middle(plan.spec, initial)
-    if towards is None or not np.linalg.norm(towards):
-        return []
     goal = _goal(plan)
-    steps = np.linspace(0.0, 1.0, 101)[:, None] * towards
+    start = np.zeros(len(plan.states)) if from_origin else _box_middle(goal)
+    if towards is None or start is None or not np.linalg.norm(towards - start):
+        return []
+    steps = start + np.linspace(0.0, 1.0, 101)[:, None] * (towards - start)
     inside = holds(goal.contains_formula(plan.states), state_env(plan.states, steps),
                    len(steps))
     extent = int(np.argmin(inside)) if not inside.all() else len(steps)
-    return [steps[int(share * (extent - 1))] for share in CENTRE_SHARES if extent > 2]
+    shares = CENTRE_SHARES if from_origin else (0.0,) + CENTRE_SHARES
+    return [steps[int(share * (extent - 1))] for share in shares if extent > 2]
+
+
+def _box_middle(region) -> np.ndarray | None:
+    box = region.bounding_box() if region is not None else None
+    return None if box is None else (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2
 
 
 def _zero_at_origin(networks: dict, controller) -> bool:

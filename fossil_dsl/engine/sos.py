@@ -58,12 +58,11 @@ class SosFinding:
 
 
 def applies(plan: Plan) -> bool:
-    """A polynomial autonomous system, a Lyapunov-type property (or safety in continuous
-    time, where the field may be rational or have elementary functions: sos_barrier.py),
-    and no template or candidate chosen by the user."""
+    """A polynomial autonomous system, a Lyapunov-type property (or safety, where an ODE
+    may be rational or have elementary functions and a map must be polynomial:
+    sos_barrier.py), and no template or candidate chosen by the user."""
     spec = plan.spec
-    form = plan.certificate.form in FORMS or (
-        plan.certificate.form == "safety" and spec.time is TimeDomain.CONTINUOUS)
+    form = plan.certificate.form in FORMS or plan.certificate.form == "safety"
     return (form and plan.controller is None and not spec.inputs
             and spec.torch_dynamics is None and spec.synthesis.certificate is None
             and spec.synthesis.candidate is None and not plan.options.learn_only

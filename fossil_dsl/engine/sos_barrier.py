@@ -24,6 +24,7 @@ from fossil_dsl.engine.polynomial_field import exact_field, padded, widened
 from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, interval_products, rounded,
                                    set_constraints, set_pieces)
 from fossil_dsl.ir import polynomials as P
+from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan
 from fossil_dsl.solvers.sdp import Program
 from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
@@ -35,6 +36,9 @@ from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
 DEGREES = (1, 2, 3)
 HIGHER_DEGREE_MAX_VARIABLES = 3000
 DECAY_RATES = (1.0, 0.1, 10.0)  # mu, in the order tried
+# for a map, B(f(x)) - B(x) <= -mu B(x) - e: B(f(x)) <= (1 - mu) B(x) <= 0 where B <= 0
+# needs mu <= 1
+MAP_DECAY_RATES = (0.5, 0.1, 1.0)
 DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 
 
@@ -42,8 +46,9 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
     started = time.monotonic()
     states = plan.states
     field = exact_field(plan, plan.spec.dynamics)
-    if field is None:
-        return None
+    discrete = plan.spec.time is TimeDomain.DISCRETE
+    if field is None or discrete and (field.facts or P.degree(field.denominator) > 0):
+        return None  # B(f(x)) of a quotient, or of a function's value, is no polynomial
     n, facts = field.variables, field.facts
     # I with its box's products: -B - e >= 0 on I with constant multipliers of I's
     # linear bounds needs -B's Hessian to be PSD, which no quadratic B positive on U
@@ -61,11 +66,11 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
     # ATOMS_MAX_VARIABLES) could not prove (s12: degree 4, 8 s), and programs with many
     # applications took 8 s (bbu09)
     for degree in DEGREES[:1] if facts else DEGREES:
-        for mu in DECAY_RATES:
+        for mu in MAP_DECAY_RATES if discrete else DECAY_RATES:
             if time.monotonic() > deadline:
                 return None
             program = BarrierProgram(n, field.numerators, initial, unsafe, domain, degree,
-                                     mu, field.denominator, len(states))
+                                     mu, field.denominator, len(states), discrete)
             largest = ATOMS_MAX_VARIABLES if facts else \
                 MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES
             if program.count > largest:
@@ -76,7 +81,9 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
             b = {m[:len(states)]: c for m, c in program.exact_b(x).items()}
             margin = float(x[program.margin])
             return SosFinding(P.to_expr(b, states), "B", 2 * degree, margin,
-                              f"B < 0 on I, B > 0 on U, dB/dt <= -{mu:g} B on D with "
+                              f"B < 0 on I, B > 0 on U, "
+                              f"{'B(f(x)) - B(x)' if discrete else 'dB/dt'} <= -{mu:g} B "
+                              f"on D with "
                               f"margin {margin:.3g}" + (" (the field's functions bounded "
                                                        "by their facts)" if facts else ""),
                               time.monotonic() - started)
@@ -89,7 +96,7 @@ class BarrierProgram(Program):
 
     def __init__(self, n: int, field, initial_pieces, unsafe_pieces, domain, degree: int,
                  mu: float, denominator: P.Polynomial | None = None,
-                 states: int | None = None):
+                 states: int | None = None, discrete: bool = False):
         super().__init__(n, searches=True)
         # B is over the first `states` variables (the rest stand for function values)
         self.basis = [widened(m, n) for m in P.monomials(states or n, 0, 2 * degree)]
@@ -103,9 +110,10 @@ class BarrierProgram(Program):
         for piece in unsafe_pieces:
             self._condition(list(zip(self.coefficients, b_terms)), piece)
         # multiplied through by the field's denominator Q > 0 (1 for a polynomial field):
-        # -grad B . N - mu B Q - e >= 0 gives dB/dt <= -mu B - e / Q
+        # -grad B . N - mu B Q - e >= 0 gives dB/dt <= -mu B - e / Q (for a map, with
+        # B(f(x)) - B(x) in place of grad B . N)
         Q = denominator or P.constant(1, n)
-        flow = [(v, P.add(P.scale(P.lie_derivative(t, field), -1),
+        flow = [(v, P.add(P.scale(P.change(t, field, discrete), -1),
                           P.scale(P.multiply(t, Q), -mu)))
                 for v, t in zip(self.coefficients, b_terms)]
         self._condition(flow, domain)

@@ -38,7 +38,7 @@ import numpy as np
 from fossil_dsl.engine.linear import operating_point
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.reach_pieces import Pieces
+from fossil_dsl.engine.reach_pieces import Pieces, set_point
 from fossil_dsl.engine.sos import Inexact, rounded
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
 from fossil_dsl.engine.surrogate import polynomial_field
@@ -119,7 +119,8 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     """The first V (and B) found, over the controllers tried and V's degrees."""
     started = time.monotonic()
     spec, states = plan.spec, plan.states
-    operating = operating_point(spec) if spec.inputs else np.zeros(0)
+    centre = set_point(plan) if spec.inputs else None
+    operating = operating_point(spec, centre) if spec.inputs else np.zeros(0)
     if operating is None:
         return None
     try:
@@ -128,7 +129,8 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
         return None
     rng = np.random.default_rng(plan.options.seed)
     discrete = spec.time is TimeDomain.DISCRETE
-    for index, (controller, gain) in enumerate(lqr_controllers(plan, operating, rng)):
+    for index, (controller, gain) in enumerate(lqr_controllers(plan, operating, rng, centre)):
+        bias = operating if centre is None else operating - gain @ centre
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
         field = _polynomial(closed, states)
         denominator, stand_in = P.constant(1, len(states)), 0
@@ -144,7 +146,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
         if found is not None:
             formulas, levels, degree, margin = found
             return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
-                                controller, gain, operating, degree, margin,
+                                controller, gain, bias, degree, margin,
                                 time.monotonic() - started, levels,
                                 P.degree(formulas["B"]) if "B" in formulas else 0, stand_in)
     return None

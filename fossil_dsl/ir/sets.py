@@ -6,7 +6,6 @@ in SHAPES; the checker and the solvers need no other change.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable, ClassVar, Sequence
 
@@ -14,6 +13,7 @@ from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import enclose, sign
 from fossil_dsl.ir.expr import Expr, Var, add, mul, power, div, Num, free_vars
 from fossil_dsl.ir.expr import to_text
+from fossil_dsl.ir.set_bounds import constraint_box
 
 Point = Sequence[Expr]
 
@@ -199,20 +199,8 @@ class Semialgebraic(SetExpr):
     states: tuple[str, ...]
 
     def bounding_box(self):
-        """The box of the constraints that bound one state by a constant (`x0 <= 2`,
-        `-1 <= x1`), if they bound every state; the set lies in it."""
-        lower = {s: -float("inf") for s in self.states}
-        upper = {s: float("inf") for s in self.states}
-        for constraint in self.constraints:
-            for var, const, below in ((constraint.left, constraint.right, True),
-                                      (constraint.right, constraint.left, False)):
-                if isinstance(var, Var) and var.name in lower and not free_vars(const):
-                    if (constraint.relation in ("<", "<=")) == below:
-                        upper[var.name] = min(upper[var.name], _high(const))
-                    else:
-                        lower[var.name] = max(lower[var.name], _low(const))
-        box = (tuple(lower[s] for s in self.states), tuple(upper[s] for s in self.states))
-        return box if all(map(math.isfinite, box[0] + box[1])) else None
+        """The box the constraints bound every state in (set_bounds.py), if they do."""
+        return constraint_box(self.constraints, self.states)
 
     def membership(self, point):
         mapping = dict(zip(self.states, point))
