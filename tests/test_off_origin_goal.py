@@ -39,3 +39,31 @@ def test_a_goal_the_inputs_cannot_move_the_state_to_is_not_certified():
     """x decays to 0 whatever u does, so x never reaches 0.5."""
     result = fossil_dsl.synthesise(fossil_dsl.loads(UNCONTROLLABLE), timeout=20, max_iters=2)
     assert not result.certified
+
+
+CAPACITY = SPECS / "probe70/at35_logistic_growth_to_capacity_rswa_raw.fsl"
+
+
+def test_a_population_reaches_and_stays_round_its_capacity():
+    """RSWA without inputs, F round the equilibrium (1, 1): the reach program's level
+    balls are centred there (engine/reach_pieces.py `StayPieces`)."""
+    result = fossil_dsl.synthesise(fossil_dsl.load(CAPACITY), timeout=60)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares")
+
+
+def test_a_band_the_population_passes_through_is_not_certified_to_hold_it():
+    """F = x in [0.4, 0.6]: the population grows through it to its capacity 1."""
+    passing = CAPACITY.read_text().replace("set final = box([0.8, 0.8], [1.2, 1.2])",
+                                           "set final = box([0.4, 0.8], [0.6, 1.2])")
+    result = fossil_dsl.synthesise(fossil_dsl.loads(passing), timeout=20, max_iters=2)
+    assert not result.certified
+
+
+def test_a_cascade_is_filled_with_the_gain_the_program_used():
+    """probe70/at42: the controller's bias at the set point is computed from the rounded
+    gain both where the program fixes it and where the network is set; before, they
+    differed in the last digit (1.686 against 1.687) and the program's V was dropped."""
+    spec = fossil_dsl.load(SPECS / "probe70/at42_level_control_corridor_rwa_ctrl.fsl")
+    result = fossil_dsl.synthesise(spec, timeout=60)
+    assert result.certified and result.strategy.startswith("sum-of-squares"), result.summary()

@@ -49,8 +49,10 @@ def lqr_controllers(plan, operating: np.ndarray, rng, centre=None):
         yield {}, None
         return
     for _, K in lqr_gains(spec, True, operating, rng, centre):
-        bias = operating if centre is None else operating + K @ centre
-        yield exact_controller(spec, -K, bias, plan.options.digits)
+        gain = np.round(-K, plan.options.digits)
+        # the bias from the rounded gain, as the caller computes it for the network
+        bias = operating if centre is None else operating - gain @ centre
+        yield exact_controller(spec, gain, bias, plan.options.digits)
 
 
 def exact_controller(spec, gain: np.ndarray, operating: np.ndarray, digits: int):

@@ -58,46 +58,64 @@ class Pieces:
 
 
 class StayPieces:
-    """For RSWA, balls round the origin (the closed loop's equilibrium) inside F, of a
-    quarter and a half of the sampled distance to F's boundary: V < β on the inner
-    one, V > β on F outside the outer one, and V decreases on D outside the inner one.
-    With β fixed, F ∩ {V >= β} then lies where V decreases and ∂F has V > β. For a map,
-    V(f(x)) < β on the inner ball too: a step from F ∩ {V <= β} then keeps V <= β."""
+    """For RSWA, balls round the closed loop's equilibrium c in F (the origin, else for a
+    system without inputs the equilibrium Newton's method finds from the middle of F's
+    box: a population at its capacity, probe70/at35), of a quarter and a half of the
+    sampled distance from c to F's boundary: V < β on the inner one, V > β on F outside
+    the outer one, and V decreases on D outside the inner one. With β fixed,
+    F ∩ {V >= β} then lies where V decreases and ∂F has V > β. For a map, V(f(x)) < β
+    on the inner ball too: a step from F ∩ {V <= β} then keeps V <= β."""
 
     def __init__(self, pieces: Pieces, final, plan: Plan):
         states = plan.states
-        reach = _distance_to_boundary(final, plan)
+        centre = _stay_centre(final, plan)
+        reach = None if centre is None else _distance_to_boundary(final, plan, centre)
         if reach is None:
-            raise Inexact("the origin is not inside F")
-        inner, outer = (_ball(states, reach / 4), _ball(states, reach / 2))
+            raise Inexact("no equilibrium found inside F")
+        inner, outer = (_ball(states, reach / 4, centre), _ball(states, reach / 2, centre))
         self.inner = [inner]
         self.decrease = [[P.scale(inner, -1)] + interval_products(pieces.domain)]
         self.above = [pieces.goal + [P.scale(outer, -1)]]
 
 
-def _ball(states, radius: float) -> P.Polynomial:
-    """r^2 - |x|^2 (>= 0 on the ball), with r^2 a short rational."""
+def _ball(states, radius: float, centre) -> P.Polynomial:
+    """r^2 - |x - c|^2 (>= 0 on the ball), with r^2 and c short rationals."""
     square = Fraction(radius ** 2).limit_denominator(10 ** 6)
-    return P.add(P.constant(square, len(states)),
-                 P.scale(P.polynomial(E.squared_norm(states), states), -1))
+    offsets = [E.add(E.Var(s), E.Num(-Fraction(float(c)).limit_denominator(10 ** 6)))
+               for s, c in zip(states, centre)]
+    norm = E.add(*(E.power(o, E.Num(2)) for o in offsets))
+    return P.add(P.constant(square, len(states)), P.scale(P.polynomial(norm, states), -1))
 
 
-def _distance_to_boundary(region, plan: Plan) -> float | None:
-    """The smallest |x| over samples of the region's boundary, where the origin lies in
-    the region (else None)."""
+def _inside(region, plan: Plan, point) -> bool:
     from fossil_dsl.engine.evaluate import holds, state_env
+    points = np.asarray(point, dtype=float).reshape(1, -1)
+    return bool(holds(region.contains_formula(plan.states), state_env(plan.states, points),
+                      1)[0])
+
+
+def _stay_centre(final, plan: Plan) -> np.ndarray | None:
+    """The origin where F holds it; else, without inputs, an equilibrium inside F."""
+    origin = np.zeros(len(plan.states))
+    if _inside(final, plan, origin):
+        return origin
+    box = final.bounding_box()
+    if plan.spec.inputs or box is None:
+        return None
+    from fossil_dsl.engine.linear import equilibrium
+    found = equilibrium(plan.spec, (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2)
+    return found if found is not None and _inside(final, plan, found) else None
+
+
+def _distance_to_boundary(region, plan: Plan, centre) -> float | None:
+    """The smallest |x - c| over samples of the region's boundary (None where it is 0)."""
     from fossil_dsl.engine.sampling import sample
     from fossil_dsl.ir.sets import Boundary
-    states = plan.states
-    origin = np.zeros((1, len(states)))
-    if not holds(region.contains_formula(states), state_env(states, origin), 1)[0]:
-        return None
-    points = np.asarray(sample(Boundary(region), states, 2000,
+    points = np.asarray(sample(Boundary(region), plan.states, 2000,
                                np.random.default_rng(plan.options.seed),
                                plan.spec.domain.bounding_box()), dtype=float)
-    distance = float(np.linalg.norm(points, axis=1).min()) if len(points) else 0.0
+    distance = float(np.linalg.norm(points - centre, axis=1).min()) if len(points) else 0.0
     return distance if distance > 0 else None
-
 
 def set_point(plan: Plan) -> np.ndarray | None:
     """Where a controller should hold the state when G (F for RSWA) lies off the origin:

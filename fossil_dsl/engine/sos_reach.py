@@ -76,8 +76,8 @@ class ReachFinding:
 
     formulas: dict
     controller: dict
-    gain: np.ndarray | None  # -K, u = -K x + operating point
-    operating: np.ndarray
+    gain: np.ndarray | None  # -K: u = -K x + operating
+    operating: np.ndarray  # the bias: the operating input, plus K c for a set point c
     degree: int  # V's (0: no V, RAR's B alone)
     margin: float
     seconds: float
@@ -191,14 +191,15 @@ def _functions(n: int, field, denominator, pieces: Pieces, deadline: float,
                discrete: bool, partial: bool = False):
     """({"V": V, "B": B for RAR}, levels, V's degree, margin) or None; the field is
     field / denominator (denominator > 0 on D), or the map (`discrete`). Where
-    `partial`, RAR's B alone when no V is found (degree 0): V's program asks for a
-    decrease on all of D outside G, which a basin smaller than D rules out."""
+    `partial` (no controller), RAR's B alone when no V is found (degree 0): V's program
+    asks for a decrease on all of D outside G, which a basin smaller than D rules out;
+    and V's programs with a growth rate are tried too."""
     b = None
     if pieces.outside_final is not None:
         b = _barrier(n, field, pieces, deadline)
         if b is None:
             return None
-    for rate, half in _shapes(pieces):
+    for rate, half in _shapes(pieces, growing=partial):
         if time.monotonic() > deadline:
             return None
         program = _ReachProgram(n, field, denominator, pieces, half, discrete, rate)
@@ -213,11 +214,14 @@ def _functions(n: int, field, denominator, pieces: Pieces, deadline: float,
     return ({"B": b}, {}, 0, 0.0) if partial and b is not None else None
 
 
-def _shapes(pieces: Pieces) -> list[tuple[float, int]]:
+def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int]]:
     """(λ, half-degree) of V's programs in turn: decrease on all of D outside G, then
-    (not for RSWA, whose decrease pieces are its own) only where V <= 0."""
+    (`growing`; not for RSWA, whose decrease pieces are its own) only where V <= 0. With
+    a controller (an LQR gain: one equilibrium in D) they served no spec of session 70's
+    reach bench and cost up to 30 s of programs and failed proofs (probe65/an14:
+    certified in 45 s -> timeout)."""
     shapes = [(0.0, half) for half in HALF_DEGREES]
-    if pieces.stay is None:
+    if growing and pieces.stay is None:
         shapes += [(rate, half) for half in GROWING_HALF_DEGREES for rate in GROWTH_RATES]
     return shapes
 
