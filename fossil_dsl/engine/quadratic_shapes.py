@@ -50,9 +50,15 @@ def lqr_controllers(plan, operating: np.ndarray, rng, centre=None):
         return
     for _, K in lqr_gains(spec, True, operating, rng, centre):
         gain = np.round(-K, plan.options.digits)
-        # the bias from the rounded gain, as the caller computes it for the network
-        bias = operating if centre is None else operating - gain @ centre
-        yield exact_controller(spec, gain, bias, plan.options.digits)
+        yield exact_controller(spec, gain, set_point_bias(operating, gain, centre),
+                               plan.options.digits)
+
+
+def set_point_bias(operating: np.ndarray, gain: np.ndarray, centre=None) -> np.ndarray:
+    """The bias b of u = gain x + b that holds the state at `centre` with the inputs
+    `operating`, from the gain as rounded: the program's formula and the network set
+    from it must agree to the last digit (probe70/at42: 1.686 against 1.687)."""
+    return operating if centre is None else operating - gain @ centre
 
 
 def exact_controller(spec, gain: np.ndarray, operating: np.ndarray, digits: int):
@@ -69,12 +75,18 @@ def _exact(value: float) -> Fraction:
     return Fraction(str(float(value)))
 
 
+def box_middle(region) -> np.ndarray | None:
+    """The middle of the set's bounding box (None where it has none)."""
+    box = None if region is None else region.bounding_box()
+    return None if box is None else (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2
+
+
 def initial_middle(spec, inside) -> np.ndarray | None:
     """The middle of I's bounding box, else the mean of the points sampled in I (None
     where there are none)."""
-    box = spec.property.role("initial").bounding_box()
-    if box is not None:
-        return (np.asarray(box[0], dtype=float) + np.asarray(box[1], dtype=float)) / 2
+    middle = box_middle(spec.property.role("initial"))
+    if middle is not None:
+        return middle
     if inside is None or not len(inside):
         return None
     return as_array(inside).mean(axis=0)

@@ -7,6 +7,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from fossil_dsl.engine.quadratic_shapes import box_middle
 from fossil_dsl.engine.sos import Inexact, faces, interval_products, set_constraints, set_pieces
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
@@ -99,11 +100,11 @@ def _stay_centre(final, plan: Plan) -> np.ndarray | None:
     origin = np.zeros(len(plan.states))
     if _inside(final, plan, origin):
         return origin
-    box = final.bounding_box()
-    if plan.spec.inputs or box is None:
+    middle = box_middle(final)
+    if plan.spec.inputs or middle is None:
         return None
     from fossil_dsl.engine.linear import equilibrium
-    found = equilibrium(plan.spec, (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2)
+    found = equilibrium(plan.spec, middle)
     return found if found is not None and _inside(final, plan, found) else None
 
 
@@ -117,17 +118,14 @@ def _distance_to_boundary(region, plan: Plan, centre) -> float | None:
     distance = float(np.linalg.norm(points - centre, axis=1).min()) if len(points) else 0.0
     return distance if distance > 0 else None
 
+
 def set_point(plan: Plan) -> np.ndarray | None:
     """Where a controller should hold the state when G (F for RSWA) lies off the origin:
     the middle of G's box, where that is in G (a tank's level: probe70/at27); None where
     the origin is in G, or the middle is not."""
-    from fossil_dsl.engine.evaluate import holds, state_env
     prop = plan.spec.property
     goal = prop.role("final") if prop.form == "reach and stay while avoid" else prop.role("goal")
-    box = goal.bounding_box() if goal is not None else None
-    if box is None:
+    middle = box_middle(goal)
+    if middle is None or _inside(goal, plan, np.zeros(len(plan.states))):
         return None
-    points = np.array([np.zeros(len(plan.states)),
-                       (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2])
-    inside = holds(goal.contains_formula(plan.states), state_env(plan.states, points), 2)
-    return points[1] if inside[1] and not inside[0] else None
+    return middle if _inside(goal, plan, middle) else None

@@ -29,8 +29,8 @@ from fossil_dsl.engine.linear import (as_array, holds_a_quadratic, is_linear,
                                       operating_point, quadratic_values, set_linear,
                                       set_quadratic)
 from fossil_dsl.engine.sampling import sample
-from fossil_dsl.engine.quadratic_shapes import (boundary_floor, initial_middle, lqr_gains,
-                                               separations)
+from fossil_dsl.engine.quadratic_shapes import (boundary_floor, box_middle, initial_middle,
+                                               lqr_gains, separations)
 from fossil_dsl.ir.sets import Boundary
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.certificates.rwa import GAMMA
@@ -105,7 +105,7 @@ def _goal_centres(plan, initial, from_origin: bool = True) -> list[np.ndarray]:
     is no equilibrium for any input), at CENTRE_SHARES of the distance to G's boundary."""
     towards = initial_middle(plan.spec, initial)
     goal = _goal(plan)
-    start = np.zeros(len(plan.states)) if from_origin else _box_middle(goal)
+    start = np.zeros(len(plan.states)) if from_origin else box_middle(goal)
     if towards is None or start is None or not np.linalg.norm(towards - start):
         return []
     steps = start + np.linspace(0.0, 1.0, 101)[:, None] * (towards - start)
@@ -114,11 +114,6 @@ def _goal_centres(plan, initial, from_origin: bool = True) -> list[np.ndarray]:
     extent = int(np.argmin(inside)) if not inside.all() else len(steps)
     shares = CENTRE_SHARES if from_origin else (0.0,) + CENTRE_SHARES
     return [steps[int(share * (extent - 1))] for share in shares if extent > 2]
-
-
-def _box_middle(region) -> np.ndarray | None:
-    box = region.bounding_box() if region is not None else None
-    return None if box is None else (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2
 
 
 def _zero_at_origin(networks: dict, controller) -> bool:

@@ -20,8 +20,8 @@ set, where g <= 0). With λ = 0 the last asks dV/dt <= -γ even where V > 0, whi
 meets where D outside G holds another equilibrium; then λ > 0 (V of degree up to 6):
 dV/dt <= λ V - γ, the condition itself where V <= 0, still linear in V. {V <= 0} may
 lie anywhere, so it need not be centred at the origin (an I on one side of G, an unsafe
-set on the other: no ellipsoid round the origin fits between them). For RAR, B (degree 2, then 4)
-comes from the barrier program (sos_barrier.py) with G for I and the part of D outside F
+set on the other: no ellipsoid round the origin fits between them). For RAR, B (degree
+2, then 4) comes from the barrier program (sos_barrier.py) with G for I and the part of D outside F
 for U; where V's program fails, B alone is returned, and V is learned beside it.
 
 Nothing here is trusted: the functions are rounded and proved like any candidate.
@@ -36,7 +36,7 @@ from fractions import Fraction
 import numpy as np
 
 from fossil_dsl.engine.linear import operating_point
-from fossil_dsl.engine.quadratic_shapes import lqr_controllers
+from fossil_dsl.engine.quadratic_shapes import lqr_controllers, set_point_bias
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.engine.reach_pieces import Pieces, set_point
 from fossil_dsl.engine.sos import Inexact, rounded
@@ -130,7 +130,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     rng = np.random.default_rng(plan.options.seed)
     discrete = spec.time is TimeDomain.DISCRETE
     for index, (controller, gain) in enumerate(lqr_controllers(plan, operating, rng, centre)):
-        bias = operating if centre is None else operating - gain @ centre
+        bias = set_point_bias(operating, gain, centre)
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
         field = _polynomial(closed, states)
         denominator, stand_in = P.constant(1, len(states)), 0
