@@ -185,7 +185,27 @@ CASES = [
                                        synthesis("candidate: u^2"))), 12, "`u` is an input"),
     ("controller-without-input", synthesis("controller: linear(2)"), 11,
      "declares no `input`"),
+    ("odd-lyapunov-tanh", edit("prove from init: always not unsafe", "prove from init: stable",
+                               synthesis("certificate: tanh(8)")), 11, "V an odd function"),
+    ("odd-lyapunov-sigmoid", edit("prove from init: always not unsafe", "prove stable",
+                                  synthesis("certificate: sigmoid(5)")), 11, "odd function"),
+    ("odd-lyapunov-tanh-cube", edit("prove from init: always not unsafe",
+                                    "prove from init: stable",
+                                    synthesis("certificate: tanh(4), cube(3)")), 11,
+     "odd function"),
 ]
+
+@pytest.mark.parametrize("layers, prove", [
+    ("tanh(8)", "prove from init: always not unsafe"),  # a barrier has biases
+    ("tanh(8), square(8)", "prove from init: stable"),
+    ("sigmoid(5), tanh(5)", "prove stable"),  # sigmoid(0) = 1/2 is passed on as a bias
+    ("poly3(6)", "prove stable"),
+])
+def test_layers_that_can_give_a_positive_v_are_accepted(layers, prove):
+    text = edit("prove from init: always not unsafe", prove, synthesis(f"certificate: {layers}"))
+    result = check_text(text, "spec.fsl")
+    assert result.ok, result.render()
+
 
 LOCATION = re.compile(r"^spec\.fsl:(\d+):(\d+): (error|warning): ", re.M)
 

@@ -227,11 +227,36 @@ def test_a_map_reach_while_avoid_is_certified_by_the_program():
     assert "every step" in result.guarantee()
 
 
-def test_a_map_with_reach_avoid_remain_is_left_to_learning():
-    """RAR's barrier program is for ODEs: a map's RAR gets no reach program."""
+def test_a_map_with_reach_avoid_remain_gets_v_and_the_maps_barrier():
+    """RAR of a map: V from the reach program, B from the barrier program for maps
+    (B(f(x)) - B(x) <= -mu B on D, so a step from {B <= 0} keeps B <= 0); the kernel
+    proves both, steps included."""
     text = MAP_RWA.replace("set unsafe", "set final = ball([0, 0], 0.4)\nset unsafe").replace(
         "not unsafe until goal", "not unsafe until (goal and always final)")
-    assert not sos_reach.applies(compile_spec(fossil_dsl.loads(text, "map.fsl")))
+    spec = fossil_dsl.loads(text, "map.fsl")
+    plan = compile_spec(spec)
+    assert sos_reach.applies_late(plan) and not sos_reach.applies(plan)
+    finding = sos_reach.search(plan, time.monotonic() + 30)
+    assert finding is not None and set(finding.formulas) == {"V", "B"}
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+    B = result.sympy["B"]
+    x0, x1 = sorted(B.free_symbols, key=str)
+    assert float(B.subs({x0: 0, x1: 0})) <= 0 < float(B.subs({x0: 0.45, x1: 0}))
+
+
+def _finds_nothing(name: str, applies=sos_reach.applies) -> None:
+    spec = fossil_dsl.load(ROOT / "specs" / "false" / f"{name}.fsl")
+    plan = compile_spec(spec)
+    assert applies(plan)
+    assert sos_reach.search(plan, time.monotonic() + 30) is None
+    assert not fossil_dsl.synthesise(spec, seed=0, timeout=20, max_iters=3).certified
+
+
+def test_the_program_finds_nothing_for_a_map_that_leaves_f_after_g():
+    """f114: x -> 0.6 x passes through G and goes on to the origin, outside F."""
+    _finds_nothing("f114_map_leaves_final_after_goal_rar", sos_reach.applies_late)
 
 
 def test_a_map_reach_and_stay_is_certified_by_the_program():
@@ -258,11 +283,7 @@ def test_a_map_reach_and_stay_is_certified_by_the_program():
 
 def test_the_program_finds_nothing_for_a_false_reach_and_stay_property_of_a_map():
     """f49: a tanh map's orbits from I overshoot into U before settling in F."""
-    spec = fossil_dsl.load(ROOT / "specs" / "false" / "f49_tanh_map_rswa_overshoot.fsl")
-    plan = compile_spec(spec)
-    assert sos_reach.applies(plan)
-    assert sos_reach.search(plan, time.monotonic() + 30) is None
-    assert not fossil_dsl.synthesise(spec, seed=0, timeout=20, max_iters=3).certified
+    _finds_nothing("f49_tanh_map_rswa_overshoot")
 
 
 @pytest.mark.parametrize("name", ["f32_map_reach_stalls", "f33_map_rwa_through_unsafe"])
@@ -393,3 +414,28 @@ def test_a_stand_in_finding_gets_longer_solver_queries():
     result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
     assert result.certified and result.kernel.certified, result.summary()
     assert "polynomial stand-in of degree" in result.strategy, result.strategy
+
+
+def test_a_decrease_out_of_reach_on_all_of_d_is_asked_in_a_box_round_i_and_g():
+    """probe71/au01, a damped radial orbit in raw coordinates: D reaches r = 0.5, where
+    the centre's pull 1/r^3 sends states out fast, and no V of degree 2 to 6 decreases on
+    all of D outside G (nor where V <= 0, with a growth rate); asked on a box round I and
+    G, with V > 0 outside it, a quartic V is found, and the kernel proves the decrease
+    where V <= 0 on all of D as always."""
+    spec = fossil_dsl.load(ROOT / "specs" / "probe71" / "au01_kepler_radial_damped_reach_raw.fsl")
+    plan = compile_spec(spec)
+    finding = sos_reach.search(plan, time.monotonic() + 30)
+    assert finding is not None and finding.confined, finding
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert "box round I and G" in result.strategy, result.strategy
+    V = result.sympy["V"]
+    r, v = sorted(V.free_symbols, key=str)
+    # V > 0 near D's faces outside the box, V <= 0 on I's corners
+    assert float(V.subs({r: 0.55, v: 0})) > 0 and float(V.subs({r: 2.45, v: 0.9})) > 0
+    assert all(float(V.subs({r: a, v: b})) <= 0 for a in (0.8, 1.3) for b in (-0.2, 0.2))
+
+
+def test_no_box_helps_a_goal_above_the_orbits_energy():
+    """f115: the goal lies above the energy of every state of I."""
+    _finds_nothing("f115_radial_orbit_goal_above_its_energy_reach")

@@ -15,6 +15,7 @@ from fossil_dsl.check.properties import (LARGEST_REGION, PropertyChecker, Proper
 from fossil_dsl.check.relations import RelationProver, Subject, check_equilibrium
 from fossil_dsl.check.sets import SetChecker, set_reference_names
 from fossil_dsl.diagnostics import Diagnostic, Span, article, has_errors
+from fossil_dsl.ir.activations import odd_without_biases
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.spec import CheckedSpec, Property, TimeDomain
@@ -237,6 +238,12 @@ class Checker:
         if "candidate" in given and "certificate" in given:
             self.context.warning("`certificate` is ignored: `candidate` gives the function "
                                  "to verify", self.spans["option:certificate"])
+        elif "certificate" in given and form.stable_type \
+                and odd_without_biases(options.certificate):
+            self.context.error("these layers make V an odd function (V(-x) = -V(x)), never "
+                               "positive on both sides of the origin as a Lyapunov function "
+                               "must be; end with an even layer, e.g. `tanh(8), square(8)`",
+                               self.spans["option:certificate"])
         return options
 
     def prove_facts(self, form, prop, domain, dynamics, equation_spans, time) -> None:

@@ -69,7 +69,8 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
                                  swa_parts.attempt, prove=_region_proved)),
                              (sos_roa.applies, _region_sum_of_squares),
                              (sos_reach.applies, _reach_sum_of_squares),
-                             (quadratic_roa.reaches, _quadratic_region)):
+                             (quadratic_roa.reaches, _quadratic_region),
+                             (sos_reach.applies_late, _reach_sum_of_squares)):
         if backend is not None and applies(plan):
             found, note = attempt(plan, backend, listener, deadline)
             if found is not None:

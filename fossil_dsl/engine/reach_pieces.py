@@ -3,6 +3,7 @@ piece: I's members, D's faces and the part of D outside S, D outside G (and F), 
 RSWA the balls round the origin inside F that fix its level."""
 from __future__ import annotations
 
+import copy
 from fractions import Fraction
 
 import numpy as np
@@ -54,8 +55,20 @@ class Pieces:
 
     def outside(self, region, states) -> list[list[P.Polynomial]]:
         """D outside the region's interior: {g <= 0} within D, one piece per g."""
-        return [[P.scale(g, -1)] + interval_products(self.domain)
-                for g in _constraints(region, states)]
+        return self._outside(_constraints(region, states))
+
+    def _outside(self, constraints) -> list[list[P.Polynomial]]:
+        return [[P.scale(g, -1)] + interval_products(self.domain) for g in constraints]
+
+    def confined(self, box: list[P.Polynomial]) -> "Pieces":
+        """The pieces for {V <= 0} inside a box B of D: V > 0 on D outside B's interior
+        too, and V's decrease asked on B outside G only (the kernel asks it where V <= 0).
+        A decrease on all of D can be out of reach where D holds states that leave it
+        fast (probe71/au01: a radial orbit, D reaching 0.5 from the attracting centre)."""
+        confined = copy.copy(self)
+        confined.boundary = self.boundary + self._outside(box)
+        confined.outside_goal = [piece + box for piece in self.outside_goal]
+        return confined
 
 
 class StayPieces:
@@ -129,3 +142,38 @@ def set_point(plan: Plan) -> np.ndarray | None:
     if middle is None or _inside(goal, plan, np.zeros(len(plan.states))):
         return None
     return middle if _inside(goal, plan, middle) else None
+
+
+CONFINING_FACTORS = (1.5, 3.0)  # of the half-widths of the hull of I's and G's boxes
+
+
+def confining_boxes(plan: Plan) -> list[list[P.Polynomial]]:
+    """Boxes round I and G, inside D's box and smaller than it, as constraint lists
+    (x - l >= 0, u - x >= 0 with short rationals); none where a box is missing."""
+    prop = plan.spec.property
+    boxes = [region.bounding_box() if region is not None else None
+             for region in (prop.role("initial"), prop.role("goal"), plan.spec.domain)]
+    if any(box is None for box in boxes):
+        return []
+    (il, iu), (gl, gu), (dl, du) = [(np.asarray(b[0], float), np.asarray(b[1], float))
+                                    for b in boxes]
+    low, high = np.minimum(il, gl), np.maximum(iu, gu)
+    found = []
+    for factor in CONFINING_FACTORS:
+        middle, half = (low + high) / 2, factor * (high - low) / 2
+        lower, upper = np.maximum(middle - half, dl), np.minimum(middle + half, du)
+        if np.allclose(lower, dl) and np.allclose(upper, du):
+            break
+        found.append(_box_constraints(plan.states, lower, upper))
+    return found
+
+
+def _box_constraints(states, lower, upper) -> list[P.Polynomial]:
+    n, constraints = len(states), []
+    for index, (low, high) in enumerate(zip(lower, upper)):
+        unit = tuple(int(i == index) for i in range(n))
+        low = Fraction(float(low)).limit_denominator(1000)
+        high = Fraction(float(high)).limit_denominator(1000)
+        constraints += [P.add({unit: Fraction(1)}, P.constant(-low, n)),
+                        P.add({unit: Fraction(-1)}, P.constant(high, n))]
+    return constraints

@@ -2,7 +2,7 @@
 polynomial ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where
 the decrease is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py;
 of any other ODE through a polynomial stand-in for its field: surrogate.py), and for
-reach, RWA and RSWA of a map (polynomial, or through a stand-in; the decrease is
+every reach-type property of a map (polynomial, or through a stand-in; the decrease is
 V(f(x)) - V(x), still linear in V's coefficients; the kernel's further conditions that a
 step from S outside G with V <= 0 lands in S, and for RSWA from F with V <= β in F, are
 left to the proof); where the system has inputs, with a linear controller
@@ -38,9 +38,9 @@ import numpy as np
 from fossil_dsl.engine.linear import operating_point
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers, set_point_bias
 from fossil_dsl.engine.rational_field import over_one_denominator
-from fossil_dsl.engine.reach_pieces import Pieces, set_point
+from fossil_dsl.engine.reach_pieces import Pieces, confining_boxes, set_point
 from fossil_dsl.engine.sos import Inexact, rounded
-from fossil_dsl.engine.sos_barrier import DECAY_RATES, BarrierProgram
+from fossil_dsl.engine.sos_barrier import DECAY_RATES, MAP_DECAY_RATES, BarrierProgram
 from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
@@ -53,7 +53,6 @@ from fossil_dsl.solvers.gram_rounding import decimal
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 
 FORMS = ("reach while avoid", "reach", "reach-avoid-remain", "reach and stay while avoid")
-DISCRETE_FORMS = ("reach while avoid", "reach", "reach and stay while avoid")
 HALF_DEGREES = (1, 2)  # V of degree 2, then 4
 # where no V decreases on all of D outside G (another equilibrium there: the rest state
 # of probe68/ar15's neuron), dV <= λ V - γ: a decrease only where V <= 0, still linear
@@ -84,6 +83,7 @@ class ReachFinding:
     levels: dict  # name -> Fraction (RSWA's β), fixed for the proof
     barrier_degree: int = 0  # RAR's B (0: none)
     stand_in: int = 0  # the degree of the field's polynomial stand-in (0: none)
+    confined: bool = False  # V > 0 outside a box round I and G (Pieces.confined)
 
     def describe(self) -> str:
         if not self.degree:
@@ -96,8 +96,9 @@ class ReachFinding:
             barrier = " and a quadratic B"
         else:
             barrier = f" and B of degree {self.barrier_degree}"
+        box = ", decreasing in a box round I and G" if self.confined else ""
         return (f"sum-of-squares programming (Clarabel): V of degree {self.degree}"
-                f"{barrier}{control}{self._stand_in()}, margin {self.margin:.3g}, "
+                f"{barrier}{control}{self._stand_in()}{box}, margin {self.margin:.3g}, "
                 f"{self.seconds:.2f} s")
 
     def _stand_in(self) -> str:
@@ -106,13 +107,19 @@ class ReachFinding:
 
 
 def applies(plan: Plan) -> bool:
-    """An ODE (polynomial, rational, or with a polynomial stand-in: surrogate.py), or a
-    map for reach and RWA (RAR's barrier program is for ODEs), a reach-type property,
-    the default templates, and at most a linear controller (the default one)."""
-    spec = plan.spec
-    discrete = spec.time is TimeDomain.DISCRETE
-    return (plan.certificate.form in (DISCRETE_FORMS if discrete else FORMS)
-            and default_synthesis(plan))
+    """An ODE (polynomial, rational, or with a polynomial stand-in: surrogate.py) or a
+    map, a reach-type property, the default templates, and at most a linear controller
+    (the default one); a map's RAR comes later (`applies_late`)."""
+    return plan.certificate.form in FORMS and default_synthesis(plan) and not applies_late(plan)
+
+
+def applies_late(plan: Plan) -> bool:
+    """A map's RAR: after the linearisation's quadratic V, which certified every such
+    spec of the repo it applies to in a few seconds, where the programs (B's above all,
+    of degree 4 for maps with stand-ins) cost up to 16 s first (probe64/am04: 4.6 ->
+    16 s); the programs certify where no ellipsoid fits (probe70/at31)."""
+    return (plan.certificate.form == "reach-avoid-remain" and default_synthesis(plan)
+            and plan.spec.time is TimeDomain.DISCRETE)
 
 
 def search(plan: Plan, deadline: float) -> ReachFinding | None:
@@ -129,8 +136,8 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
         return None
     rng = np.random.default_rng(plan.options.seed)
     discrete = spec.time is TimeDomain.DISCRETE
+    loops = []
     for index, (controller, gain) in enumerate(lqr_controllers(plan, operating, rng, centre)):
-        bias = set_point_bias(operating, gain, centre)
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
         field = _polynomial(closed, states)
         denominator, stand_in = P.constant(1, len(states)), 0
@@ -141,15 +148,29 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
             field, denominator, stand_in = found
         if time.monotonic() > deadline or stand_in and index >= STAND_IN_CONTROLLERS:
             break
-        found = _functions(len(states), field, denominator, pieces, deadline, discrete,
-                           partial=not controller)
+        loops.append((controller, gain, field, denominator, stand_in))
+        found = _functions(len(states), field, denominator, _shapes(pieces, not controller),
+                           pieces, deadline, discrete, partial=not controller)
         if found is not None:
-            formulas, levels, degree, margin = found
-            return ReachFinding({name: P.to_expr(p, states) for name, p in formulas.items()},
-                                controller, gain, bias, degree, margin,
-                                time.monotonic() - started, levels,
-                                P.degree(formulas["B"]) if "B" in formulas else 0, stand_in)
+            return _finding(plan, found, loops[-1], centre, operating, started)
+    # then, for the first closed loop, {V <= 0} in a box round I and G: after every
+    # loop's own programs (probe59/ac15's second gain: found 10 s later behind them)
+    confining = [(0.0, half, pieces.confined(box)) for box in confining_boxes(plan)
+                 for half in HALF_DEGREES]
+    if loops and confining and pieces.stay is None and pieces.outside_final is None:
+        found = _functions(len(states), *loops[0][2:4], confining, pieces, deadline, discrete)
+        if found is not None:
+            return _finding(plan, found, loops[0], centre, operating, started)
     return None
+
+
+def _finding(plan: Plan, found, loop, centre, operating, started: float) -> ReachFinding:
+    formulas, levels, degree, margin, confined = found
+    controller, gain, _, _, stand_in = loop
+    return ReachFinding({name: P.to_expr(p, plan.states) for name, p in formulas.items()},
+                        controller, gain, set_point_bias(operating, gain, centre), degree,
+                        margin, time.monotonic() - started, levels,
+                        P.degree(formulas["B"]) if "B" in formulas else 0, stand_in, confined)
 
 
 def _over_denominator(closed, plan: Plan, pieces: Pieces, discrete: bool):
@@ -187,22 +208,22 @@ def _polynomial(expressions, variables):
         return None
 
 
-def _functions(n: int, field, denominator, pieces: Pieces, deadline: float,
+def _functions(n: int, field, denominator, shapes, pieces: Pieces, deadline: float,
                discrete: bool, partial: bool = False):
-    """({"V": V, "B": B for RAR}, levels, V's degree, margin) or None; the field is
-    field / denominator (denominator > 0 on D), or the map (`discrete`). Where
+    """({"V": V, "B": B for RAR}, levels, V's degree, margin, whether confined) or None;
+    the field is field / denominator (denominator > 0 on D), or the map. Where
     `partial` (no controller), RAR's B alone when no V is found (degree 0): V's program
     asks for a decrease on all of D outside G, which a basin smaller than D rules out;
     and V's programs with a growth rate are tried too."""
     b = None
     if pieces.outside_final is not None:
-        b = _barrier(n, field, pieces, deadline)
+        b = _barrier(n, field, pieces, deadline, discrete)
         if b is None:
             return None
-    for rate, half in _shapes(pieces, growing=partial):
+    for rate, half, asked in shapes:
         if time.monotonic() > deadline:
             return None
-        program = _ReachProgram(n, field, denominator, pieces, half, discrete, rate)
+        program = _ReachProgram(n, field, denominator, asked, half, discrete, rate)
         if program.count > MAX_VARIABLES:
             continue
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
@@ -210,30 +231,34 @@ def _functions(n: int, field, denominator, pieces: Pieces, deadline: float,
             found = {"V": program.exact_v(x)}
             if b is not None:
                 found["B"] = b
-            return found, program.levels(x), 2 * half, float(x[program.margin])
-    return ({"B": b}, {}, 0, 0.0) if partial and b is not None else None
+            return (found, program.levels(x), 2 * half, float(x[program.margin]),
+                    asked is not pieces)
+    return ({"B": b}, {}, 0, 0.0, False) if partial and b is not None else None
 
 
-def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int]]:
-    """(λ, half-degree) of V's programs in turn: decrease on all of D outside G, then
-    (`growing`; not for RSWA, whose decrease pieces are its own) only where V <= 0. With
-    a controller (an LQR gain: one equilibrium in D) they served no spec of session 70's
-    reach bench and cost up to 30 s of programs and failed proofs (probe65/an14:
-    certified in 45 s -> timeout)."""
-    shapes = [(0.0, half) for half in HALF_DEGREES]
+def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int, Pieces]]:
+    """(λ, half-degree, pieces) of V's programs in turn: decrease on all of D outside G,
+    then (`growing`; not for RSWA, whose decrease pieces are its own) only where V <= 0.
+    With a controller (an LQR gain: one equilibrium in D) the latter served no spec of
+    session 70's reach bench and cost up to 30 s of programs and failed proofs
+    (probe65/an14: certified in 45 s -> timeout)."""
+    shapes = [(0.0, half, pieces) for half in HALF_DEGREES]
     if growing and pieces.stay is None:
-        shapes += [(rate, half) for half in GROWING_HALF_DEGREES for rate in GROWTH_RATES]
+        shapes += [(rate, half, pieces) for half in GROWING_HALF_DEGREES
+                   for rate in GROWTH_RATES]
     return shapes
 
 
-def _barrier(n: int, field, pieces: Pieces, deadline: float):
-    """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B on D, of degree 2, then 4 (a
-    hardening spring's x^3 outgrows every quadratic's decay on D: probe54/o07); or None."""
-    for half, mu in itertools.product(HALF_DEGREES, DECAY_RATES):
+def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool):
+    """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B on D (for a map B(f(x)) - B(x)
+    <= -mu B), of degree 2, then 4 (a hardening spring's x^3 outgrows every quadratic's
+    decay on D: probe54/o07); or None."""
+    rates = MAP_DECAY_RATES if discrete else DECAY_RATES
+    for half, mu in itertools.product(HALF_DEGREES, rates):
         if time.monotonic() > deadline:
             return None
         program = BarrierProgram(n, field, [pieces.goal], pieces.outside_final, pieces.domain,
-                                 half, mu)
+                                 half, mu, discrete=discrete)
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
             return program.exact_b(x)

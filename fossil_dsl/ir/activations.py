@@ -32,6 +32,8 @@ class Activation:
     zero_at_zero: bool
     symbolic: Callable[[E.Expr, int, int], E.Expr]  # (pre-activation, neuron, width)
     tensor: Callable  # (batch, width) tensor -> same shape
+    # whether a(z) - a(0) is odd in z, for the neuron (index, width)
+    odd: Callable[[int, int], bool] = lambda i, w: False
 
     def apply(self, z: E.Expr, index: int, width: int) -> E.Expr:
         return self.symbolic(z, index, width)
@@ -40,7 +42,7 @@ class Activation:
 def _power(n: int) -> Activation:
     name = {1: "linear", 2: "square", 3: "cube"}[n]
     return Activation(name, n, True, lambda z, i, w: E.power(z, E.Num(n)),
-                      lambda t: t if n == 1 else t ** n)
+                      lambda t: t if n == 1 else t ** n, lambda i, w: n % 2 == 1)
 
 
 def _poly(degree: int) -> Activation:
@@ -52,7 +54,8 @@ def _poly(degree: int) -> Activation:
         return t ** powers
 
     return Activation(f"poly{degree}", degree, True,
-                      lambda z, i, w: E.power(z, E.Num(_chunk_power(i, w, degree))), tensor)
+                      lambda z, i, w: E.power(z, E.Num(_chunk_power(i, w, degree))), tensor,
+                      lambda i, w: _chunk_power(i, w, degree) % 2 == 1)
 
 
 def _softplus(t):
@@ -67,8 +70,19 @@ ACTIVATIONS: dict[str, Activation] = {a.name: a for a in (
                lambda t: t.relu()),
     Activation("sigmoid", None, False,
                lambda z, i, w: E.add(HALF, E.mul(HALF, E.apply("tanh", E.mul(HALF, z)))),
-               lambda t: t.sigmoid()),
-    Activation("tanh", None, True, lambda z, i, w: E.apply("tanh", z), lambda t: t.tanh()),
+               lambda t: t.sigmoid(), lambda i, w: True),
+    Activation("tanh", None, True, lambda z, i, w: E.apply("tanh", z), lambda t: t.tanh(),
+               lambda i, w: True),
     Activation("softplus", None, False,
                lambda z, i, w: E.apply("log", E.add(E.ONE, E.apply("exp", z))), _softplus),
 )}
+
+
+def odd_without_biases(layers) -> bool:
+    """Whether a network of these hidden layers (name, width), a linear output, no biases
+    and its value at 0 subtracted, is an odd function of its input for every weight:
+    every neuron's a(z) - a(0) odd, and a(0) = 0 in each layer before the last (a
+    constant passed on acts as a bias)."""
+    *inner, last = [(ACTIVATIONS[layer.activation], layer.width) for layer in layers]
+    return (all(a.zero_at_zero for a, _ in inner)
+            and all(a.odd(i, w) for a, w in (*inner, last) for i in range(w)))
