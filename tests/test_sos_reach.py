@@ -439,3 +439,23 @@ def test_a_decrease_out_of_reach_on_all_of_d_is_asked_in_a_box_round_i_and_g():
 def test_no_box_helps_a_goal_above_the_orbits_energy():
     """f115: the goal lies above the energy of every state of I."""
     _finds_nothing("f115_radial_orbit_goal_above_its_energy_reach")
+
+
+def test_a_maps_rar_gets_b_decaying_on_f_and_v_in_a_box_round_i_and_g():
+    """probe61/af13, harvested patches (a map with an input): states at D's lower corner
+    leave D (e - e^2/2 falls away), so no B decays on all of D and no V decreases on all
+    of D outside G. {B <= 0} lies in F (B > 0 on D outside F), so B's decay is asked on
+    F only; V's decrease on a box round I and G, V > 0 outside it. The kernel proves
+    B(f(x)) <= 0 wherever B(x) <= 0 in D, and V's conditions, on all of D."""
+    spec = fossil_dsl.load(ROOT / "specs" / "probe61" / "af13_harvested_patches_map_rar_ctrl.fsl")
+    plan = compile_spec(spec)
+    finding = sos_reach.search(plan, time.monotonic() + 30)
+    assert finding is not None and finding.confined and set(finding.formulas) == {"V", "B"}
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert "box round I and G" in result.strategy, result.strategy
+    B = result.sympy["B"]
+    e1, e2 = sorted(B.free_symbols, key=str)
+    assert float(B.subs({e1: 0, e2: 0})) <= 0
+    assert all(float(B.subs({e1: a, e2: b})) > 0  # D outside F, its lower corner too
+               for a, b in ((-0.44, -0.44), (0.3, 0.3), (0.16, 0), (0, -0.16)))

@@ -48,6 +48,9 @@ class Pieces:
         final = prop.role("final")
         self.outside_final = self.outside(final, states) if final is not None and \
             not staying else None
+        # RAR's B > 0 on D outside F puts {B <= 0} inside F: B's decay may be asked there
+        self.final = None if self.outside_final is None else \
+            _constraints(final, states) + self.domain
         self.stay = StayPieces(self, goal, plan) if staying else None
 
     def faces(self) -> list[list[P.Polynomial]]:

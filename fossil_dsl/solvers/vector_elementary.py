@@ -143,7 +143,9 @@ def exp_at(x):
         value = V.square(value)
     low = np.where(x < EXP_BOTTOM, 0.0, np.maximum(value[0], 0.0))
     high = np.where(x < EXP_BOTTOM, 5e-324, value[1])
-    return np.where(x > EXP_TOP, np.finfo(float).max, low), np.where(x > EXP_TOP, np.inf, high)
+    # above EXP_TOP, exp(EXP_TOP)'s lower bound still holds (exp grows), and exp(x) may
+    # be up to the largest double (exp(709.5) = 1.35e308): no larger lower bound is safe
+    return low, np.where(x > EXP_TOP, np.inf, high)
 
 
 def exp(a):
