@@ -32,6 +32,7 @@ import itertools
 import time
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import NamedTuple
 
 import numpy as np
 
@@ -152,7 +153,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
             _barrier(len(states), field, pieces, deadline, discrete)
         if pieces.outside_final is not None and b is None:
             continue
-        loops.append((controller, gain, field, denominator, stand_in, b))
+        loops.append(_Loop(controller, gain, field, denominator, stand_in, b))
         found = _functions(len(states), field, denominator, b, _shapes(pieces, not controller),
                            pieces, deadline, discrete, partial=not controller)
         if found is not None:
@@ -162,20 +163,32 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     confining = [(0.0, half, pieces.confined(box)) for box in confining_boxes(plan)
                  for half in HALF_DEGREES]
     if loops and confining and pieces.stay is None:
-        found = _functions(len(states), *loops[0][2:4], loops[0][5], confining, pieces,
-                           deadline, discrete)
+        first = loops[0]
+        found = _functions(len(states), first.field, first.denominator, first.barrier,
+                           confining, pieces, deadline, discrete)
         if found is not None:
             return _finding(plan, found, loops[0], centre, operating, started)
     return None
 
 
-def _finding(plan: Plan, found, loop, centre, operating, started: float) -> ReachFinding:
+class _Loop(NamedTuple):
+    """A closed loop tried: the controller, its field over a denominator, RAR's B."""
+    controller: dict
+    gain: np.ndarray | None
+    field: list
+    denominator: P.Polynomial
+    stand_in: int
+    barrier: P.Polynomial | None
+
+
+def _finding(plan: Plan, found, loop: _Loop, centre, operating, started: float) -> ReachFinding:
     formulas, levels, degree, margin, confined = found
-    controller, gain, _, _, stand_in, _ = loop
     return ReachFinding({name: P.to_expr(p, plan.states) for name, p in formulas.items()},
-                        controller, gain, set_point_bias(operating, gain, centre), degree,
-                        margin, time.monotonic() - started, levels,
-                        P.degree(formulas["B"]) if "B" in formulas else 0, stand_in, confined)
+                        loop.controller, loop.gain,
+                        set_point_bias(operating, loop.gain, centre), degree, margin,
+                        time.monotonic() - started, levels,
+                        P.degree(formulas["B"]) if "B" in formulas else 0, loop.stand_in,
+                        confined)
 
 
 def _over_denominator(closed, plan: Plan, pieces: Pieces, discrete: bool):
