@@ -193,6 +193,10 @@ CASES = [
                                     "prove from init: stable",
                                     synthesis("certificate: tanh(4), cube(3)")), 11,
      "odd function"),
+    ("relu-flow-barrier", synthesis("certificate: relu(8), square(4)"), 11, "`relu` has a kink"),
+    ("relu-flow-lyapunov", edit("prove from init: always not unsafe", "prove stable",
+                                synthesis("certificate: softplus(4), relu(8), square(4)")), 11,
+     "use `softplus`"),
 ]
 
 @pytest.mark.parametrize("layers, prove", [

@@ -9,13 +9,12 @@ from typing import Sequence
 
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
-from fossil_dsl.check.options import OptionReader
+from fossil_dsl.check.options import OptionReader, template_findings
 from fossil_dsl.check.properties import (LARGEST_REGION, PropertyChecker, PropertyForm,
                                          formula_set_names)
 from fossil_dsl.check.relations import RelationProver, Subject, check_equilibrium
 from fossil_dsl.check.sets import SetChecker, set_reference_names
 from fossil_dsl.diagnostics import Diagnostic, Span, article, has_errors
-from fossil_dsl.ir.activations import odd_without_biases
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.spec import CheckedSpec, Property, TimeDomain
@@ -75,7 +74,7 @@ class Checker:
             self.warn_unused()
             return None
         prop, form = checked
-        options = self.check_option_use(options, given, form)
+        options = self.check_option_use(options, given, form, time)
         if options.region == "largest" and form.name == "stability":
             form = LARGEST_REGION
             prop = replace(prop, form=form.name, certificate=form.certificate)
@@ -221,7 +220,7 @@ class Checker:
             return None
         return PropertyChecker(self.context, sets).check(decl)
 
-    def check_option_use(self, options, given: set, form: PropertyForm):
+    def check_option_use(self, options, given: set, form: PropertyForm, time):
         if "max_iters" not in given:
             options = replace(options, max_iters=form.max_iters)
         if "controller" in given and not self.context.inputs:
@@ -238,12 +237,10 @@ class Checker:
         if "candidate" in given and "certificate" in given:
             self.context.warning("`certificate` is ignored: `candidate` gives the function "
                                  "to verify", self.spans["option:certificate"])
-        elif "certificate" in given and form.stable_type \
-                and odd_without_biases(options.certificate):
-            self.context.error("these layers make V an odd function (V(-x) = -V(x)), never "
-                               "positive on both sides of the origin as a Lyapunov function "
-                               "must be; end with an even layer, e.g. `tanh(8), square(8)`",
-                               self.spans["option:certificate"])
+        for level, message, key in template_findings(
+                options, given, form.stable_type, time is TimeDomain.CONTINUOUS,
+                len(self.context.states)):
+            getattr(self.context, level)(message, self.spans[f"option:{key}"])
         return options
 
     def prove_facts(self, form, prop, domain, dynamics, equation_spans, time) -> None:

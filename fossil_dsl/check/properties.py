@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.sets import SetChecker
+from fossil_dsl.check.state_formulas import as_set, combined_sets, key, set_parts
 from fossil_dsl.diagnostics import Span
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.spec import Property
@@ -91,11 +92,19 @@ def register_form(form: PropertyForm) -> None:
 # ---- normal form: nested tuples ------------------------------------------------------
 # ("stable",) ("lit", name, negated) ("always", x) ("eventually", x) ("not", x)
 # ("until", a, b) ("and", (a, b, ...)) ("or", (a, b, ...))
+_DUAL = {"always": "eventually", "eventually": "always"}  # not always A = eventually not A
+
+
 def normalise(node: ast.Formula, negated: bool = False) -> tuple:
     if isinstance(node, ast.FSet):
         return ("lit", node.name, negated)
+    combined = as_set(node) if isinstance(node, ast.FBinary) else None
+    if combined is not None:
+        return ("lit", key(combined), negated)
     if isinstance(node, ast.FUnary) and node.op == "not":
         return normalise(node.operand, not negated)
+    if negated and isinstance(node, ast.FUnary) and node.op in _DUAL:
+        return (_DUAL[node.op], normalise(node.operand, True))
     if negated:
         return ("not", normalise(node))
     if isinstance(node, ast.FStable):
@@ -104,15 +113,7 @@ def normalise(node: ast.Formula, negated: bool = False) -> tuple:
         return (node.op, normalise(node.operand))
     if node.op == "until":
         return ("until", normalise(node.left), normalise(node.right))
-    return (node.op, tuple(_flatten(node, node.op)))
-
-
-def _flatten(node: ast.Formula, op: str):
-    if isinstance(node, ast.FBinary) and node.op == op:
-        yield from _flatten(node.left, op)
-        yield from _flatten(node.right, op)
-    else:
-        yield normalise(node)
+    return (node.op, tuple(normalise(part) for part in set_parts(node)))
 
 
 def match(pattern: tuple, node: tuple, binding: dict) -> dict | None:
@@ -228,11 +229,13 @@ class PropertyChecker:
 
     def _roles(self, decl, form, binding) -> dict[str, S.SetExpr] | None:
         spans = _literal_spans(decl.formula)
+        combined = combined_sets(decl.formula)
         roles: dict[str, S.SetExpr | None] = {"domain": self.sets.domain}
         if decl.initial is not None:
             roles["initial"] = self.sets.convert(decl.initial)
         for letter, (name, negated) in binding.items():
-            value = self.sets.reference(ast.SetRef(name, spans[name]))
+            written = combined.get(name) or ast.SetRef(name, spans[name])
+            value = self.sets.convert(written)
             roles.update(_letter_roles(letter, value, negated, self.sets.domain))
         if "goal" in roles and "safe" not in roles:  # `eventually G`: safe is the domain
             roles["safe"] = self.sets.domain

@@ -12,8 +12,8 @@ import time
 import numpy as np
 from dataclasses import replace
 
-from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos, sos_reach,
-                               sos_roa, swa_parts)
+from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos,
+                               sos_controlled, sos_reach, sos_roa, swa_parts)
 from fossil_dsl.engine.learning import learn, learning_imported
 from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, budgets, only_function,
                                        prove_found, verify_given)
@@ -64,6 +64,7 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
                              (first_integral.applies, _conserved),
                              (repelling.applies, _repelling),
                              (sos.applies, _sum_of_squares),
+                             (sos_controlled.applies, _controlled_sum_of_squares),
                              (quadratic_roa.applies, _quadratic_region),
                              (swa_parts.applies, functools.partial(
                                  swa_parts.attempt, prove=_region_proved)),
@@ -224,6 +225,18 @@ def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
         found, note = prove_found(ball, backend, listener, deadline, finding, budget,
                                   BASIN_QUERY_SECONDS)
     return found, note
+
+
+def _controlled_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
+    """((plan with B given and the controller set, certified outcome) or None, what
+    happened)."""
+    listener.phase(0, "sum-of-squares program (closed loop)")
+    budget = min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
+    finding = sos_controlled.search(plan, time.monotonic() + budget)
+    if finding is None:
+        return None, "no sum-of-squares barrier found for an LQR gain"
+    return prove_found(plan, backend, listener, deadline, finding, budget,
+                       prepare=lambda cegis: _controller_set(cegis, finding))
 
 
 def _lemma_ball(plan: Plan, finding) -> Plan | None:

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from fossil_dsl.engine import quadratic_layers
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir.calculus import derivative
@@ -231,8 +232,8 @@ def as_array(points) -> np.ndarray:
 
 
 def holds_a_quadratic(network: Network, n: int) -> bool:
-    return (len(network.linears) == 1 and network.activations[0].name == "square"
-            and network.linears[0].out_features >= n)
+    """Whether the network's layers can hold x^T P x (quadratic_layers.py)."""
+    return quadratic_layers.route(network, n) is not None
 
 
 def is_linear(network: Network, outputs: int) -> bool:
@@ -242,25 +243,11 @@ def is_linear(network: Network, outputs: int) -> bool:
 
 
 def set_quadratic(network: Network, P: np.ndarray, level: float = 0.0, centre=None) -> None:
-    """First layer: the rows of L^T (P = L L^T), then zero rows' worth of output, so
-    V(x) = |L^T x|^2 - level = x^T P x - level exactly; the spare units start with output
-    weight 0. A layer that sees x / d (input divisors) holds L^T d. With a `centre` c
-    (the network must have biases), the first layer's biases are -L^T c: V(x) =
-    (x - c)^T P (x - c) - level."""
-    import torch
-    factor = torch.as_tensor(np.linalg.cholesky(P).T, dtype=torch.float64)
-    shift = None if centre is None else -factor @ torch.as_tensor(centre, dtype=torch.float64)
-    if network.divisors is not None:
-        factor = factor * network.input_divisor
-    n = len(P)
-    with torch.no_grad():
-        weight, output = network.linears[0].weight, network.output.weight
-        weight[:n] = factor
-        output.zero_()
-        output[0, :n] = 1.0
-        _set_output_bias(network, [-level])
-        if shift is not None:
-            network.linears[0].bias[:n] = shift
+    """V(x) = (x - c)^T P (x - c) - level in the network's weights: the last hidden layer
+    squares the rows of L^T (P = L L^T), the layers before pass x on
+    (quadratic_layers.py); the spare units start with output weight 0. A network with a
+    `centre` c must have biases."""
+    quadratic_layers.write(network, P, level, centre)
 
 
 def set_linear(network: Network, gain: np.ndarray, offset=None) -> None:

@@ -12,7 +12,7 @@ from fossil_dsl.engine.quadratic_shapes import box_middle
 from fossil_dsl.engine.sos import Inexact, faces, interval_products, set_constraints, set_pieces
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
-from fossil_dsl.ir.sets import Complement
+from fossil_dsl.ir.sets import Box, Complement
 from fossil_dsl.plan.compile import Plan
 
 
@@ -172,11 +172,7 @@ def confining_boxes(plan: Plan) -> list[list[P.Polynomial]]:
 
 
 def _box_constraints(states, lower, upper) -> list[P.Polynomial]:
-    n, constraints = len(states), []
-    for index, (low, high) in enumerate(zip(lower, upper)):
-        unit = tuple(int(i == index) for i in range(n))
-        low = Fraction(float(low)).limit_denominator(1000)
-        high = Fraction(float(high)).limit_denominator(1000)
-        constraints += [P.add({unit: Fraction(1)}, P.constant(-low, n)),
-                        P.add({unit: Fraction(-1)}, P.constant(high, n))]
-    return constraints
+    """The box's constraints, its corners rounded to short rationals."""
+    def short(values):
+        return tuple(E.Num(Fraction(float(v)).limit_denominator(1000)) for v in values)
+    return _constraints(Box(short(lower), short(upper)), states)

@@ -23,7 +23,7 @@ from fractions import Fraction
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
-from fossil_dsl.ir.sets import Named, Union
+from fossil_dsl.ir.sets import Complement, Named, Union
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.solvers.positivstellensatz import comparisons, conjuncts
 from fossil_dsl.solvers.sdp import Program
@@ -156,7 +156,23 @@ def set_pieces(region, states, exact: bool = False) -> list[list[P.Polynomial]]:
         return set_pieces(region.value, states, exact)
     if isinstance(region, Union):
         return set_pieces(region.left, states, exact) + set_pieces(region.right, states, exact)
+    if isinstance(region, Complement):
+        outside = _outside_pieces(region, states, exact)
+        if outside is not None:
+            return outside
     return [set_constraints(region, states, exact)]
+
+
+def _outside_pieces(region, states, exact: bool) -> list[list[P.Polynomial]] | None:
+    """D minus A, for A = {every g >= 0}: one piece per g, D with -g >= 0 (the closure; a
+    condition asked on it is asked on a little more). Without them the complement of a
+    box was D itself, and no B is positive on all of D (probe72/av37: U outside a box)."""
+    try:
+        inside = set_constraints(region.operand, states, exact=True)
+    except Inexact:
+        return None
+    return [piece + [P.scale(g, -1)] for g in inside
+            for piece in set_pieces(region.domain, states, exact)] or None
 
 
 def interval_products(constraints: list[P.Polynomial]) -> list[P.Polynomial]:

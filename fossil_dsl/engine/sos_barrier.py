@@ -34,7 +34,9 @@ from fossil_dsl.solvers.sos_refutation import ATOMS_MAX_VARIABLES, MAX_VARIABLES
 # programs of 1 877 and 2 465 variables, and a chemostat (probe53/n03, rational) one of
 # degree 6; with them they have quadratic ones, and the chemostat a quartic one)
 DEGREES = (1, 2, 3)
-HIGHER_DEGREE_MAX_VARIABLES = 3000
+# probe72/av37 (4 states, U outside a box: 8 pieces) has a quartic B from a program of
+# 3 611 variables, solved in about 1 s
+HIGHER_DEGREE_MAX_VARIABLES = 4000
 DECAY_RATES = (1.0, 0.1, 10.0)  # mu, in the order tried
 # for a map, B(f(x)) - B(x) <= -mu B(x) - e: B(f(x)) <= (1 - mu) B(x) <= 0 where B <= 0
 # needs mu <= 1
@@ -42,10 +44,13 @@ MAP_DECAY_RATES = (0.5, 0.1, 1.0)
 DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 
 
-def barrier(plan: Plan, deadline: float) -> SosFinding | None:
+def barrier(plan: Plan, deadline: float, dynamics=None,
+            min_margin: float = MIN_MARGIN) -> SosFinding | None:
+    """B for the spec's field, or for `dynamics` (a closed loop) in its place, with a
+    margin above `min_margin`."""
     started = time.monotonic()
     states = plan.states
-    field = exact_field(plan, plan.spec.dynamics)
+    field = exact_field(plan, plan.spec.dynamics if dynamics is None else dynamics)
     discrete = plan.spec.time is TimeDomain.DISCRETE
     if field is None or discrete and (field.facts or P.degree(field.denominator) > 0):
         return None  # B(f(x)) of a quotient, or of a function's value, is no polynomial
@@ -76,7 +81,7 @@ def barrier(plan: Plan, deadline: float) -> SosFinding | None:
             if program.count > largest:
                 return None
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
-            if x is None or x[program.margin] <= MIN_MARGIN:
+            if x is None or x[program.margin] <= min_margin:
                 continue
             b = {m[:len(states)]: c for m, c in program.exact_b(x).items()}
             margin = float(x[program.margin])

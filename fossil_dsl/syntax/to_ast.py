@@ -1,6 +1,8 @@
 """Lark parse tree -> syntax tree (fossil_dsl.syntax.ast), positions kept."""
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from lark import Token, Transformer, v_args
 
 from fossil_dsl.diagnostics import Span
@@ -20,6 +22,20 @@ def _ident(token: Token) -> ast.Ident:
 
 def _present(children) -> tuple:
     return tuple(child for child in children if child is not None)
+
+
+class _OptionHead(NamedTuple):
+    name: ast.Ident
+
+
+def _options(pieces):
+    """`NAME: item, item, NAME: item` (heads and items in source order) -> Options."""
+    heads = [i for i, piece in enumerate(pieces) if isinstance(piece, _OptionHead)]
+    for start, end in zip(heads, heads[1:] + [len(pieces)]):
+        name, values = pieces[start].name, tuple(pieces[start + 1:end])
+        last = values[-1].span
+        span = Span(name.span.line, name.span.column, last.end_line, last.end_column)
+        yield ast.Option(name, values, span)
 
 
 @v_args(meta=True)
@@ -68,10 +84,10 @@ class ToAst(Transformer):
         return ast.ProveDecl(children[0], children[1], meta_span(meta))
 
     def synthesis_decl(self, meta, children):
-        return ast.SynthesisDecl(_present(children), meta_span(meta))
+        return ast.SynthesisDecl(tuple(_options(_present(children))), meta_span(meta))
 
-    def option(self, meta, children):
-        return ast.Option(_ident(children[0]), tuple(children[1:]), meta_span(meta))
+    def option_head(self, meta, children):
+        return _OptionHead(_ident(children[0]))
 
     def named_count(self, meta, children):
         name, count = children
