@@ -439,7 +439,10 @@ def test_line_continuation_outside_brackets():
     crlf = text.replace("\n", "\r\n")  # a backslash before CRLF continues the line too
     assert essentials(checked(crlf)) == essentials(checked(PLAIN))
     # without the backslash, the newline ends the statement
-    assert not check_text(edit(PLAIN, "state x0, x1", "state x0,\n      x1")).ok
+    assert not check_text(edit(PLAIN, "x0' = -k*x0 + x1", "x0' = -k*x0\n          + x1")).ok
+    # except after a comma, where no statement can end (an extension: docs/language.md)
+    after_comma = edit(PLAIN, "state x0, x1", "state x0,\n      x1")
+    assert essentials(checked(after_comma)) == essentials(checked(PLAIN))
 
 
 def test_newlines_inside_parentheses_and_brackets():

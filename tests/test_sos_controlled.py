@@ -50,6 +50,7 @@ def test_four_rooms_are_certified_by_the_closed_loop_program():
     result = fossil_dsl.synthesise(fossil_dsl.load(ROOMS), timeout=120)
     assert result.certified and result.kernel.certified, result.summary()
     assert "for an LQR gain" in result.strategy
+    assert result.kernel.strengthened == "never leaves D"  # B > 0 on D's faces as well
 
 
 def test_a_room_no_heater_reaches_is_not_certified():

@@ -61,3 +61,10 @@ def test_a_trailing_comma_is_a_syntax_error_at_the_brace():
     result = check_text(SPEC + "synthesis { seed: 1, }\n")
     assert not result.ok
     assert result.errors[0].span.line == 8 and "}" in result.errors[0].message
+
+
+def test_a_line_ending_in_a_comma_goes_on():
+    block = ("synthesis { verifier: interval, delta: 0.001,\n"
+             "            certificate: tanh(4),\n                         square(3),\n"
+             "            samples: domain 300, max_iters: 7 }\n")
+    assert synthesis_of(block) == synthesis_of(ONE_PER_LINE)

@@ -21,7 +21,7 @@ import time
 from fractions import Fraction
 
 from fossil_dsl.engine.polynomial_field import exact_field, padded, widened
-from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, interval_products, rounded,
+from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, faces, interval_products, rounded,
                                    set_constraints, set_pieces)
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.spec import TimeDomain
@@ -44,10 +44,11 @@ MAP_DECAY_RATES = (0.5, 0.1, 1.0)
 DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 
 
-def barrier(plan: Plan, deadline: float, dynamics=None,
-            min_margin: float = MIN_MARGIN) -> SosFinding | None:
+def barrier(plan: Plan, deadline: float, dynamics=None, min_margin: float = MIN_MARGIN,
+            boundary: bool = False) -> SosFinding | None:
     """B for the spec's field, or for `dynamics` (a closed loop) in its place, with a
-    margin above `min_margin`."""
+    margin above `min_margin`; with `boundary`, B > 0 on D's faces too (the kernel's
+    "never leaves D")."""
     started = time.monotonic()
     states = plan.states
     field = exact_field(plan, plan.spec.dynamics if dynamics is None else dynamics)
@@ -66,6 +67,8 @@ def barrier(plan: Plan, deadline: float, dynamics=None,
                for piece in set_pieces(plan.spec.property.role("initial"), states)]
     unsafe = [padded(piece + plain_domain, n)
               for piece in set_pieces(plan.spec.property.role("unsafe"), states)]
+    if boundary:
+        unsafe += [padded(face, n) for face in faces(plain_domain)]
     # with facts, a quadratic B only, from small programs: those of higher degree gave
     # tiny margins (a05: degree 6, 5 s lost) or B's the kernel's refutations (at most
     # ATOMS_MAX_VARIABLES) could not prove (s12: degree 4, 8 s), and programs with many

@@ -1,8 +1,10 @@
 """A barrier by sum-of-squares programming for safety with inputs: the controller is
 fixed beforehand to an LQR gain of the linearisation (rounded as the verifier will see
 it; u = -K x + u* round the operating input u*), and the barrier program
-(sos_barrier.py) is solved for the closed loop. The first B found is handed on with its
-controller; nothing here is trusted: both are proved like any candidate and controller.
+(sos_barrier.py) is solved for the closed loop, first with B > 0 on D's faces as well
+(so that the kernel can prove "never leaves D", the guarantee without D's qualifier),
+then without. The first B found is handed on with its controller; nothing here is
+trusted: both are proved like any candidate and controller.
 
 Where I and U are boxes close together no ellipsoid fits between them (a 4-room heater,
 I = [-1, 1]^4 inside U's complement [-1.5, 1.5]^4: every ellipsoid holding I's corners
@@ -66,7 +68,8 @@ def search(plan: Plan, deadline: float) -> ControlledBarrier | None:
         if time.monotonic() > deadline:
             return None
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
-        found = barrier(plan, deadline, closed, MIN_MARGIN)
+        found = barrier(plan, deadline, closed, MIN_MARGIN, boundary=True) \
+            or barrier(plan, deadline, closed, MIN_MARGIN)
         if found is not None:
             return ControlledBarrier(found.formula, "B", found.degree, found.margin,
                                      found.condition, time.monotonic() - started,

@@ -51,7 +51,10 @@ class BracketTracker(PostLex):
         for token in stream:
             if token.type == "_NL":
                 after_newline = True
-                self.swallowed_newline = bool(self.newline_free) and self.newline_free[-1]
+                # no statement ends with a comma: the line goes on (`certificate:
+                # sigmoid(6),` then `square(6)` on the next line)
+                self.swallowed_newline = (bool(self.newline_free) and self.newline_free[-1]) \
+                    or (previous is not None and previous.type == "COMMA")
                 if not self.swallowed_newline:
                     yield token
                 continue
