@@ -7,8 +7,10 @@ from fractions import Fraction
 import pytest
 
 from fossil_dsl import check_text
+from fossil_dsl.ir import expr as E
+from fossil_dsl.ir import logic as L
 from fossil_dsl.ir import sets as S
-from tests.test_constructs import holds
+from fossil_dsl.ir.atoms import folded
 
 HEADER = """\
 state x, y
@@ -32,8 +34,10 @@ def spec_of(prove: str):
 
 
 def inside(region: S.SetExpr, x: str, y: str) -> bool:
-    point = {"x": Fraction(x), "y": Fraction(y)}
-    return holds(region.contains_formula(("x", "y")), point)
+    point = {"x": E.Num(Fraction(x)), "y": E.Num(Fraction(y))}
+    decided = L.truth(folded(L.substitute(region.contains_formula(("x", "y")), point), ()))
+    assert decided is not None, "exact rationals decide membership"
+    return decided
 
 
 @pytest.mark.parametrize("prove", [
