@@ -10,7 +10,7 @@ from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
 from fossil_dsl.diagnostics import Span, did_you_mean
 from fossil_dsl.ir import expr as E
-from fossil_dsl.ir.activations import ACTIVATIONS, odd_without_biases
+from fossil_dsl.ir.activations import ACTIVATIONS, _chunk_power, odd_without_biases
 from fossil_dsl.ir.spec import Layer, SampleCounts, SynthesisOptions
 from fossil_dsl.solvers import registry
 from fossil_dsl.syntax import ast
@@ -172,17 +172,17 @@ READERS: dict[str, Callable[[OptionReader, ast.Option], object]] = {
 
 def template_findings(options: SynthesisOptions, given: set, stable_type: bool,
                       continuous: bool, states: int) -> list[tuple[str, str, str]]:
-    """(level, message, key) for templates that can never give a certificate (errors: an
+    """(level, message, key) for templates that can never give a certificate (findings: an
     odd V for a stable-type form; relu in a continuous-time certificate, whose kinks leave
     dV/dt undefined on a surface through D that no proof can avoid), or hardly ever
     (a warning: a single polyN layer with fewer quadratic neurons than states)."""
-    errors = []
+    findings = []
     layers = options.certificate if "certificate" in given else None
     if stable_type and layers and len(layers) == 1 and layers[0].activation.startswith("poly"):
         degree, width = ACTIVATIONS[layers[0].activation].polynomial_degree, layers[0].width
-        squares = sum(1 + (i * degree) // width == 2 for i in range(width))
+        squares = sum(_chunk_power(i, width, degree) == 2 for i in range(width))
         if squares < states:
-            errors.append(("warning", f"`{layers[0].activation}({width})` splits its neurons "
+            findings.append(("warning", f"`{layers[0].activation}({width})` splits its neurons "
                            f"into {degree} chunks of powers 1 to {degree}: only {squares} "
                            f"square a linear form, so V's quadratic part is singular in "
                            f"{states} states and V hardly ever decreases near the origin; use "
@@ -190,7 +190,7 @@ def template_findings(options: SynthesisOptions, given: set, stable_type: bool,
                            "certificate"))
     if "certificate" in given and "candidate" not in given and stable_type \
             and odd_without_biases(options.certificate):
-        errors.append(("error", "these layers make V an odd function (V(-x) = -V(x)), "
+        findings.append(("error", "these layers make V an odd function (V(-x) = -V(x)), "
                        "never positive on both sides of the origin as a Lyapunov function "
                        "must be; end with an even layer, e.g. `tanh(8), square(8)`",
                        "certificate"))
@@ -198,9 +198,8 @@ def template_findings(options: SynthesisOptions, given: set, stable_type: bool,
         layers = getattr(options, key)
         if continuous and key in given and layers \
                 and any(layer.activation == "relu" for layer in layers):
-            errors.append(("error", "`relu` has a kink where its input is 0, so dV/dt "
+            findings.append(("error", "`relu` has a kink where its input is 0, so dV/dt "
                            "(dB/dt) is undefined there and the flow condition cannot be "
-                           "proved; use "
-                           "`softplus`, its smooth counterpart (relu suits maps and "
+                           "proved; use `softplus`, its smooth counterpart (relu suits maps and "
                            "controllers)", key))
-    return errors
+    return findings
