@@ -82,6 +82,9 @@ def verdict(spec) -> str:
     unsafe, goal = prop.role("unsafe"), prop.role("goal") or prop.role("final")
     safe = prop.role("safe") or spec.domain
     stable = prop.form in ("stability", "region of attraction", "stable while avoid")
+    # RAR: once in G, in F for ever; RSWA: in F at the end
+    remain = prop.role("final") if prop.form == "reach-avoid-remain" else None
+    settle = prop.role("final") if prop.form == "reach and stay while avoid" else None
     alive = np.ones(len(start), dtype=bool)  # inside D (or S) so far
     reached = member(goal, states, start)
     for x in trajectories(spec, start, alive):
@@ -91,6 +94,8 @@ def verdict(spec) -> str:
         # enters U also leaves S and would otherwise be frozen before it counts.
         if (member(unsafe, states, x) & alive & ~reached).any():
             return "violated: a trajectory enters the unsafe set"
+        if remain is not None and (reached & ~member(remain, states, x)).any():
+            return "violated: a trajectory leaves F after reaching G"
         alive &= member(safe, states, x)
         if stable and not alive.all():
             return "violated: a trajectory leaves the domain"
@@ -98,6 +103,8 @@ def verdict(spec) -> str:
     if stable and not (np.linalg.norm(x, axis=1) < CONVERGED).all():
         return f"violated: {int((np.linalg.norm(x, axis=1) >= CONVERGED).sum())} " \
                "trajectories do not converge to the origin"
+    if settle is not None and not member(settle, states, x).all():
+        return "violated: a trajectory is outside F at the end"
     if goal is not None and not reached.all():
         return f"violated: {int((~reached).sum())} trajectories never reach the goal"
     return "looks true"

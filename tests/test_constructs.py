@@ -1052,6 +1052,6 @@ def test_safe_set_arrangement_rejects_initial_set_outside_the_domain(formula):
 
 
 def test_no_unused_warning_for_the_initial_set_of_a_rejected_formula():
-    result = check_text(property_spec("from init: eventually always final"))
+    result = check_text(property_spec("from init: always eventually final"))
     assert not result.ok  # the formula is outside the table
     assert not any("`init`" in w.message for w in result.warnings), result.render()

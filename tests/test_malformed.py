@@ -251,7 +251,7 @@ def test_all_findings_are_collected_not_only_the_first():
 
 
 def test_unsupported_property_names_every_supported_form():
-    text = edit("always not unsafe", "eventually always unsafe")
+    text = edit("always not unsafe", "always eventually unsafe")
     [error] = check_text(text).errors
     notes = " ".join(error.notes)
     for form in ("`stable`", "`from I: stable`", "`from I: always not U`",

@@ -402,8 +402,8 @@ def test_user_defined_certificate_from_the_docs(registries, capsys):
     assert "reach-and-stay certificate" in capsys.readouterr().out
     # the new form is now part of the language, for the checker and the CLI alike
     spec = spec_text(FALSE_PROPERTIES["goal-never-reached"].replace(
-        "eventually goal", "eventually always goal"))
-    assert spec.property.form == "reach and stay"
+        "eventually goal", "always eventually goal"))
+    assert spec.property.form == "recurrence"
     assert not fossil_dsl.synthesise(spec, max_iters=2, learn_steps=300).certified
 
 

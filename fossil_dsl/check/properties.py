@@ -8,6 +8,7 @@ F (final). Formulas are normalised (double negations removed, `~` read as `not`)
 """
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import functools
 import itertools
@@ -37,10 +38,17 @@ class PropertyForm:
     origin_roles: tuple[str, ...] = ()  # must contain the origin when a controller is built
     max_iters: int = 25
     functions: int = 1
+    # equivalent formulas; a letter of `pattern` that one lacks takes its default role
+    alternatives: tuple[str, ...] = ()
 
     @functools.cached_property
     def normal(self) -> tuple:
         return normalise(parse_formula(self.pattern))
+
+    @functools.cached_property
+    def normals(self) -> tuple[tuple, ...]:
+        return (self.normal,) + tuple(normalise(parse_formula(text))
+                                      for text in self.alternatives)
 
     def display(self) -> str:
         return f"from I: {self.pattern}" if self.needs_initial else self.pattern
@@ -62,13 +70,19 @@ FORMS: list[PropertyForm] = [
     # anywhere, a tank's level at its set point: probe70/at27), so G need not hold 0
     PropertyForm("reach while avoid", "reach-while-avoid", "not U until G",
                  relations=_INTERIOR),
+    # `always not U and eventually X` is `not U until X` once F and U are disjoint (a
+    # relation proved here); without U, S is the domain and U is empty
     PropertyForm("reach and stay while avoid", "RWA + stay level set",
                  "not U until always F",
+                 alternatives=("eventually always F", "always not U and eventually always F"),
                  relations=(("inside_interior", "initial", "safe"),
                             ("disjoint", "final", "unsafe")),
                  origin_roles=("final",)),
+    # `always not U and eventually G` stays out of U after G too: F is the safe set
     PropertyForm("reach-avoid-remain", "RWA + barrier", "not U until (G and always F)",
                  max_iters=100, functions=2,
+                 alternatives=("eventually (G and always F)", "always not U and eventually G",
+                               "always not U and eventually (G and always F)"),
                  relations=_INTERIOR + (("inside", "goal", "final"),
                                         ("disjoint", "final", "unsafe")),
                  origin_roles=("goal", "final")),
@@ -193,19 +207,20 @@ class PropertyChecker:
         if found is None:
             return None
         form, binding = found
-        roles = self._roles(decl, form, binding)
+        roles, implied = self._roles(decl, form, binding)
         if roles is None:
             return None
         text = _source_text(decl)
-        return Property(form.name, form.certificate, roles, text), form
+        # relations of a filled-in F (the safe set) or U (empty) follow from the others
+        relations = tuple(r for r in form.relations if not implied & set(r[1:]))
+        return Property(form.name, form.certificate, roles, text), \
+            dataclasses.replace(form, relations=relations)
 
     def _find(self, node, has_initial, decl):
-        for form in FORMS:
-            binding = match(form.normal, node, {})
-            if binding is not None and form.needs_initial == has_initial:
+        for form, binding in _matches(node):
+            if form.needs_initial == has_initial:
                 return form, binding
-        for form in FORMS:
-            if match(form.normal, node, {}) is not None:
+        for form, _ in _matches(node):
                 self._initial_mismatch(form, decl)
                 return None
         self._unsupported(node, has_initial, decl)
@@ -227,7 +242,7 @@ class PropertyChecker:
             f"supported form is `{nearest.display()}` ({nearest.name})", decl.formula.span,
             f"supported forms: {supported}")
 
-    def _roles(self, decl, form, binding) -> dict[str, S.SetExpr] | None:
+    def _roles(self, decl, form, binding) -> tuple[dict[str, S.SetExpr] | None, set[str]]:
         spans = _literal_spans(decl.formula)
         combined = combined_sets(decl.formula)
         roles: dict[str, S.SetExpr | None] = {"domain": self.sets.domain}
@@ -237,11 +252,44 @@ class PropertyChecker:
             written = combined.get(name) or ast.SetRef(name, spans[name])
             value = self.sets.convert(written)
             roles.update(_letter_roles(letter, value, negated, self.sets.domain))
-        if "goal" in roles and "safe" not in roles:  # `eventually G`: safe is the domain
-            roles["safe"] = self.sets.domain
+        implied = _default_roles(roles, form, binding)
         if any(value is None for value in roles.values()):
-            return None
-        return roles
+            return None, implied
+        return roles, implied
+
+
+def _matches(node: tuple):
+    """(form, binding) of every form one of whose formulas the normal form matches."""
+    for form in FORMS:
+        for normal in form.normals:
+            binding = match(normal, node, {})
+            if binding is not None:
+                yield form, binding
+                break
+
+
+def _default_roles(roles: dict, form: PropertyForm, binding: dict) -> set[str]:
+    """Fill in the roles of letters the written formula left out, and return the filled
+    in roles that are implied: without U the safe set is the domain and U is empty;
+    without F (`always not U and eventually G`) F is the safe set."""
+    letters, implied = _letters(form.normal), set()
+    domain = roles["domain"]
+    if "unsafe" not in roles and "safe" not in roles and ("U" in letters or "goal" in roles):
+        roles["safe"] = domain
+        if "U" in letters and domain is not None:
+            roles["unsafe"] = S.Complement(domain, domain)
+            implied.add("unsafe")
+    if "F" in letters and "F" not in binding:
+        roles["final"] = roles.get("safe")
+        implied.add("final")
+    return implied
+
+
+def _letters(node: tuple) -> set[str]:
+    if node[0] == "lit":
+        return {node[1]}
+    parts = node[1] if node[0] in ("and", "or") else node[1:]
+    return set().union(*(_letters(part) for part in parts if isinstance(part, tuple)))
 
 
 def _letter_roles(letter, value, negated, domain) -> dict:

@@ -14,7 +14,7 @@ from dataclasses import replace
 
 from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos,
                                sos_controlled, sos_reach, sos_roa, swa_parts)
-from fossil_dsl.engine.learning import learn, learning_imported
+from fossil_dsl.engine.learning import learn, learn_briefly, learning_imported
 from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, budgets, only_function,
                                        prove_found, verify_given)
 from fossil_dsl.engine.sos_barrier import barrier
@@ -229,13 +229,19 @@ def _sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
 
 def _controlled_sum_of_squares(plan: Plan, backend: Backend, listener, deadline: float):
     """((plan with B given and the controller set, certified outcome) or None, what
-    happened)."""
-    listener.phase(0, "sum-of-squares program (closed loop)")
-    budget = min(SOS_SECONDS, SOS_SHARE * plan.options.timeout)
-    finding = sos_controlled.search(plan, time.monotonic() + budget)
+    happened): a quadratic B's programs, the learning loop's first iteration, then the
+    programs of higher degree."""
+    phase = "sum-of-squares program (closed loop)"
+    finding = _program_finding(plan, listener, phase, sos_controlled.quadratic)
+    if finding is None:
+        quick = learn_briefly(plan, backend, listener, deadline)
+        if quick is not None:
+            return quick, ""
+        finding = _program_finding(plan, listener, phase, sos_controlled.higher)
     if finding is None:
         return None, "no sum-of-squares barrier found for an LQR gain"
-    return prove_found(plan, backend, listener, deadline, finding, budget,
+    return prove_found(plan, backend, listener, deadline, finding,
+                       min(SOS_SECONDS, SOS_SHARE * plan.options.timeout),
                        prepare=lambda cegis: _controller_set(cegis, finding))
 
 

@@ -242,9 +242,7 @@ def set_floor(P: np.ndarray, region, centre: np.ndarray) -> float | None:
     if isinstance(region, S.Box):
         return _box_minimum(P, centre, *bounds)
     if isinstance(region, S.Ball):
-        middle, radius = bounds
-        gap = np.linalg.norm(centre - middle) - radius
-        return float(np.linalg.eigvalsh(P)[0] * gap ** 2) if gap > 0 else 0.0
+        return _ball_minimum(P, np.asarray(bounds[0], float) - centre, bounds[1])
     return None
 
 
@@ -289,6 +287,28 @@ def _box_minimum(P, centre, low, high, steps: int = 500) -> float:
             break
         x = moved
     return float((x - centre) @ P @ (x - centre))
+
+
+def _ball_minimum(P, middle, radius: float, halvings: int = 100) -> float:
+    """min of y^T P y over the ball |y - m| <= r (λmin(P) times the gap squared was too
+    low for a flat P: probe73/aw30's seed was refused beside an obstacle it missed). On
+    the sphere, P y = μ (m - y) at the minimum: y = μ (P + μ)^-1 m, whose distance from
+    m falls and whose value rises as μ grows; μ by bisection in the eigenbasis of P."""
+    if np.linalg.norm(middle) <= radius:
+        return 0.0
+    eigenvalues, basis = np.linalg.eigh(P)
+    z = basis.T @ middle
+
+    def distance(mu: float) -> float:
+        return float(np.sqrt(np.sum((eigenvalues / (eigenvalues + mu) * z) ** 2)))
+    low, high = 0.0, 1.0
+    while distance(high) > radius:
+        low, high = high, 2 * high
+    for _ in range(halvings):
+        middle_mu = (low + high) / 2
+        low, high = (middle_mu, high) if distance(middle_mu) > radius else (low, middle_mu)
+    y = low / (eigenvalues + low) * z  # just outside the ball: its value is below the min
+    return float(np.sum(eigenvalues * y ** 2))
 
 
 def _unnamed(region):

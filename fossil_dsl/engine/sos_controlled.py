@@ -13,12 +13,13 @@ quartic B can (the sum of x_i^4 bounds the max norm within 4^(1/4)).
 """
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from fossil_dsl.engine.sos_barrier import barrier
+from fossil_dsl.engine.sos_barrier import DEGREES, barrier
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
 from fossil_dsl.plan.compile import Plan, default_synthesis
@@ -54,7 +55,9 @@ def applies(plan: Plan) -> bool:
             and plan.controller is not None and default_synthesis(plan))
 
 
-def search(plan: Plan, deadline: float) -> ControlledBarrier | None:
+def search(plan: Plan, deadline: float, degrees=DEGREES) -> ControlledBarrier | None:
+    """The first B (of twice one of `degrees`) found for a closed loop, with its
+    controller; None where there is none by the deadline."""
     from fossil_dsl.engine.linear import operating_point  # imports torch
     from fossil_dsl.engine.quadratic_shapes import lqr_controllers
     started = time.monotonic()
@@ -68,10 +71,16 @@ def search(plan: Plan, deadline: float) -> ControlledBarrier | None:
         if time.monotonic() > deadline:
             return None
         closed = [traversal.substitute(f, controller) for f in spec.dynamics]
-        found = barrier(plan, deadline, closed, MIN_MARGIN, boundary=True) \
-            or barrier(plan, deadline, closed, MIN_MARGIN)
+        found = barrier(plan, deadline, closed, MIN_MARGIN, True, degrees) \
+            or barrier(plan, deadline, closed, MIN_MARGIN, False, degrees)
         if found is not None:
             return ControlledBarrier(found.formula, "B", found.degree, found.margin,
                                      found.condition, time.monotonic() - started,
                                      controller, gain, operating)
     return None
+
+
+# quadratic B's take milliseconds; quartic and sextic ones up to 30 s (probe44/y13: 28 s),
+# where the learning loop's first iteration is often the proof: tried in between
+quadratic = functools.partial(search, degrees=DEGREES[:1])
+higher = functools.partial(search, degrees=DEGREES[1:])

@@ -129,7 +129,9 @@ class Result:
             "fossil_dsl": __version__,
             "spec": {"name": plan.spec.name, "path": plan.spec.path,
                      "text": plan.spec.source},
-            "property": {"form": plan.spec.property.form, "formula": plan.spec.property.text},
+            "property": {"form": plan.spec.property.form, "formula": plan.spec.property.text,
+                         "roles": {role: region.text()
+                                   for role, region in plan.spec.property.roles.items()}},
             "certificate": plan.certificate.title,
             "certificate_kind": type(plan.certificate).__name__,
             "verdict": self.verdict,
