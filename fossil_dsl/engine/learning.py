@@ -16,7 +16,7 @@ from fossil_dsl.solvers.api import Backend
 # seconds left, at least, for a run with quartic templates to be worth starting
 RICHER_MIN_SECONDS = 5.0
 # before a costly program: the loop's first iteration, within this many seconds
-BRIEF_ITERATIONS, BRIEF_SECONDS = 1, 10.0
+BRIEF_ITERATIONS, BRIEF_SECONDS = 1, 5.0
 
 
 def learn(plan: Plan, backend: Backend, listener, deadline: float,
