@@ -221,8 +221,8 @@ class PropertyChecker:
             if form.needs_initial == has_initial:
                 return form, binding
         for form, _ in _matches(node):
-                self._initial_mismatch(form, decl)
-                return None
+            self._initial_mismatch(form, decl)
+            return None
         self._unsupported(node, has_initial, decl)
         return None
 

@@ -45,10 +45,10 @@ DECIMALS = 6  # kept of B's coefficients (each is at most 1)
 
 
 def barrier(plan: Plan, deadline: float, dynamics=None, min_margin: float = MIN_MARGIN,
-            boundary: bool = False, degrees=DEGREES) -> SosFinding | None:
+            boundary: bool = False, degrees=None) -> SosFinding | None:
     """B for the spec's field, or for `dynamics` (a closed loop) in its place, with a
     margin above `min_margin`; with `boundary`, B > 0 on D's faces too (the kernel's
-    "never leaves D"); B of twice the `degrees` in turn."""
+    "never leaves D"); B of twice the `degrees` in turn (by default DEGREES)."""
     started = time.monotonic()
     states = plan.states
     field = exact_field(plan, plan.spec.dynamics if dynamics is None else dynamics)
@@ -73,6 +73,7 @@ def barrier(plan: Plan, deadline: float, dynamics=None, min_margin: float = MIN_
     # tiny margins (a05: degree 6, 5 s lost) or B's the kernel's refutations (at most
     # ATOMS_MAX_VARIABLES) could not prove (s12: degree 4, 8 s), and programs with many
     # applications took 8 s (bbu09)
+    degrees = DEGREES if degrees is None else degrees
     for degree in (d for d in degrees if not facts or d == DEGREES[0]):
         for mu in MAP_DECAY_RATES if discrete else DECAY_RATES:
             if time.monotonic() > deadline:

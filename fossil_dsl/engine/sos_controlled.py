@@ -55,7 +55,7 @@ def applies(plan: Plan) -> bool:
             and plan.controller is not None and default_synthesis(plan))
 
 
-def search(plan: Plan, deadline: float, degrees=DEGREES) -> ControlledBarrier | None:
+def search(plan: Plan, deadline: float, degrees=None) -> ControlledBarrier | None:
     """The first B (of twice one of `degrees`) found for a closed loop, with its
     controller; None where there is none by the deadline."""
     from fossil_dsl.engine.linear import operating_point  # imports torch
