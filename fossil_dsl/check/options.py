@@ -10,7 +10,7 @@ from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.expressions import ExpressionChecker
 from fossil_dsl.diagnostics import Span, did_you_mean
 from fossil_dsl.ir import expr as E
-from fossil_dsl.ir.activations import ACTIVATIONS, _chunk_power, odd_without_biases
+from fossil_dsl.ir.activations import ACTIVATIONS, odd_without_biases, poly_neurons
 from fossil_dsl.ir.spec import Layer, SampleCounts, SynthesisOptions
 from fossil_dsl.solvers import registry
 from fossil_dsl.syntax import ast
@@ -180,7 +180,7 @@ def template_findings(options: SynthesisOptions, given: set, stable_type: bool,
     layers = options.certificate if "certificate" in given else None
     if stable_type and layers and len(layers) == 1 and layers[0].activation.startswith("poly"):
         degree, width = ACTIVATIONS[layers[0].activation].polynomial_degree, layers[0].width
-        squares = sum(_chunk_power(i, width, degree) == 2 for i in range(width))
+        squares = len(poly_neurons(width, degree, 2))
         if squares < states:
             findings.append(("warning", f"`{layers[0].activation}({width})` splits its neurons "
                            f"into {degree} chunks of powers 1 to {degree}: only {squares} "

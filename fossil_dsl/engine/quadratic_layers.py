@@ -17,14 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from fossil_dsl.ir.activations import _chunk_power
+from fossil_dsl.ir.activations import poly_neurons
 
 EPS = 0.05  # tanh(0.05 x) is within 1.3 % of 0.05 x for |x| <= 4
-
-
-def _power_indices(activation, width: int, power: int) -> list[int]:
-    degree = activation.polynomial_degree
-    return [i for i in range(width) if _chunk_power(i, width, degree) == power]
 
 
 def _passing(activation, width: int, n: int):
@@ -34,7 +29,7 @@ def _passing(activation, width: int, n: int):
     if name == "linear" and width >= n:
         return list(range(n)), eye, eye
     if name.startswith("poly"):
-        rows = _power_indices(activation, width, 1)[:n]
+        rows = poly_neurons(width, activation.polynomial_degree, 1)[:n]
         return (rows, eye, eye) if len(rows) == n else None
     if name in ("relu", "softplus") and width >= 2 * n:
         return list(range(2 * n)), np.vstack([eye, -eye]), np.hstack([eye, -eye])
@@ -50,7 +45,7 @@ def _squaring_rows(activation, width: int, n: int) -> list[int] | None:
     if activation.name == "square":
         return list(range(n)) if width >= n else None
     if activation.name.startswith("poly"):
-        rows = _power_indices(activation, width, 2)[:n]
+        rows = poly_neurons(width, activation.polynomial_degree, 2)[:n]
         return rows if len(rows) == n else None
     return None
 

@@ -25,6 +25,11 @@ def _chunk_power(index: int, width: int, degree: int) -> int:
     return 1 + (index * degree) // width
 
 
+def poly_neurons(width: int, degree: int, power: int) -> list[int]:
+    """The neurons of a polyN layer (N = degree) that raise their input to `power`."""
+    return [i for i in range(width) if _chunk_power(i, width, degree) == power]
+
+
 @dataclass(frozen=True)
 class Activation:
     name: str
