@@ -29,6 +29,7 @@ set U = ball([-1.5, -1.5], 0.2)
 set G = ball([0, 0], 0.3)
 set F = ball([0, 0], 0.5)
 set S = ~U
+set V = ball([1.5, -1.5], 0.2)
 """
 
 
@@ -81,6 +82,28 @@ def test_settling_for_ever_is_reach_and_stay(prove):
     assert inside(prop.role("final"), "0.4", "0") and not inside(prop.role("final"), "1", "0")
 
 
+@pytest.mark.parametrize("prove, form", [
+    ("from I: always not U and always not V", "safety"),
+    ("from I: not eventually U and not eventually V", "safety"),
+    ("from I: always not U and stable and always not V", "stable while avoid"),
+    ("from I: always not V and eventually G and always not U", "reach-avoid-remain"),
+    ("from I: always not V and eventually always F and always not U",
+     "reach and stay while avoid"),
+])
+def test_avoiding_each_set_for_ever_is_avoiding_their_union(prove, form):
+    """`always A and always B` is `always (A and B)`: both obstacles become one U."""
+    prop = property_of(prove)
+    assert prop.form == form
+    unsafe = prop.role("unsafe")
+    assert inside(unsafe, "-1.5", "-1.5") and inside(unsafe, "1.5", "-1.5")
+    assert not inside(unsafe, "0", "0") and not inside(unsafe, "1.5", "1.5")
+
+
+def test_the_merged_property_keeps_the_words_the_user_wrote():
+    prop = property_of("from I: always not U and always not V")
+    assert "always not U" in prop.text and "always not V" in prop.text
+
+
 def test_a_goal_that_touches_the_avoided_set_is_refused_with_a_witness():
     result = checked("from I: always not U and eventually (U or G)")
     assert not result.ok
@@ -89,7 +112,8 @@ def test_a_goal_that_touches_the_avoided_set_is_refused_with_a_witness():
 
 @pytest.mark.parametrize("prove", ["from I: stable and eventually G",
                                    "from I: always eventually G",
-                                   "from I: not U until eventually G"])
+                                   "from I: not U until eventually G",
+                                   "from I: (not U until G) and always not V"])
 def test_formulas_with_no_certificate_stay_errors(prove):
     result = checked(prove)
     assert not result.ok and "unsupported property" in result.render()

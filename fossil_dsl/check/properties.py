@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 from fossil_dsl.check.context import CheckContext
 from fossil_dsl.check.sets import SetChecker
-from fossil_dsl.check.state_formulas import as_set, combined_sets, key, set_parts
+from fossil_dsl.check.state_formulas import (as_set, combined_sets, key, merge_always,
+                                             set_parts)
 from fossil_dsl.diagnostics import Span
 from fossil_dsl.ir import sets as S
 from fossil_dsl.ir.spec import Property
@@ -201,13 +202,14 @@ class PropertyChecker:
         self.sets = sets
 
     def check(self, decl: ast.ProveDecl) -> tuple[Property, PropertyForm] | None:
-        node = normalise(decl.formula)
+        formula = merge_always(decl.formula)
+        node = normalise(formula)
         has_initial = decl.initial is not None
         found = self._find(node, has_initial, decl)
         if found is None:
             return None
         form, binding = found
-        roles, implied = self._roles(decl, form, binding)
+        roles, implied = self._roles(decl, formula, form, binding)
         if roles is None:
             return None
         text = _source_text(decl)
@@ -242,9 +244,10 @@ class PropertyChecker:
             f"supported form is `{nearest.display()}` ({nearest.name})", decl.formula.span,
             f"supported forms: {supported}")
 
-    def _roles(self, decl, form, binding) -> tuple[dict[str, S.SetExpr] | None, set[str]]:
-        spans = _literal_spans(decl.formula)
-        combined = combined_sets(decl.formula)
+    def _roles(self, decl, formula, form, binding) -> tuple[dict[str, S.SetExpr] | None,
+                                                            set[str]]:
+        spans = _literal_spans(formula)
+        combined = combined_sets(formula)
         roles: dict[str, S.SetExpr | None] = {"domain": self.sets.domain}
         if decl.initial is not None:
             roles["initial"] = self.sets.convert(decl.initial)

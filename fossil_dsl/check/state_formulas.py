@@ -4,6 +4,10 @@ A part of a formula built from set names with `not`, `and` and `or` alone says w
 state is at one instant, so it is a set: `rock or pit` is `rock | pit`, `not hot` is
 `~hot`, `safe and not hot` is `safe & ~hot`. The property table's letters (U, G, F) then
 bind to that set as they bind to a single name.
+
+`always A and always B` says what `always (A and B)` says, and `not eventually A` what
+`always not A` says: `merge_always` joins them, so that `always not rock and always not
+pit` is safety with the unsafe set `rock | pit`.
 """
 from __future__ import annotations
 
@@ -24,6 +28,39 @@ def as_set(node: ast.Formula) -> ast.SetExpr | None:
         if left is None or right is None:
             return None
         return ast.SetBinary(_SET_OPERATOR[node.op], left, right, node.span)
+    return None
+
+
+def merge_always(node: ast.Formula) -> ast.Formula:
+    """The formula with the `always` of set formulas in each chain of `and` joined into
+    one `always`."""
+    if isinstance(node, ast.FUnary):
+        return ast.FUnary(node.op, merge_always(node.operand), node.span)
+    if not isinstance(node, ast.FBinary):
+        return node
+    if node.op != "and":
+        return ast.FBinary(node.op, merge_always(node.left), merge_always(node.right),
+                           node.span)
+    items = [merge_always(item) for item in flatten(node, "and")]
+    invariants = [_invariant(item) for item in items]
+    joined = [inv for inv in invariants if inv is not None]
+    if len(joined) < 2:
+        return combine(items, "and")
+    rest = [item for item, inv in zip(items, invariants) if inv is None]
+    always = ast.FUnary("always", combine(joined, "and"), joined[0].span)
+    return combine(rest + [always], "and")
+
+
+def _invariant(node: ast.Formula) -> ast.Formula | None:
+    """A for `always A` and `not A` for `not eventually A`, where A is a set formula."""
+    if not isinstance(node, ast.FUnary):
+        return None
+    if node.op == "always" and as_set(node.operand) is not None:
+        return node.operand
+    inner = node.operand
+    if node.op == "not" and isinstance(inner, ast.FUnary) and inner.op == "eventually" \
+            and as_set(inner.operand) is not None:
+        return ast.FUnary("not", inner.operand, node.span)
     return None
 
 
