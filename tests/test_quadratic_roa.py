@@ -9,6 +9,7 @@ import sympy
 
 import fossil_dsl
 from fossil_dsl.engine import quadratic_roa
+from fossil_dsl.ir.symbolic import to_sympy
 from fossil_dsl.outputs.recheck import recheck
 from fossil_dsl.plan.compile import compile_spec
 
@@ -191,4 +192,69 @@ def test_b_is_left_out_where_its_sublevel_set_cannot_hold_g_inside_f():
 
 def test_false_reach_avoid_remain_properties_get_no_candidate():
     for name in ("f10_rar_no_remain", "f77_exp_feedback_map_leaves_stay_rar"):
+        assert _reach_candidates(ROOT / "specs" / "false" / f"{name}.fsl") == [], name
+
+
+SAMPLED_CHAIN = ROOT / "specs" / "probe74" / "ax33_sine_map_rar_ctrl_3d.fsl"
+
+
+def test_reach_avoid_remain_takes_b_from_the_ellipsoid_between_g_and_f():
+    """probe74/ax33, a sampled 3-state chain with sin: no LQR shape has a sublevel set
+    holding G's ball of 0.2 inside F's of 0.4 (timeout in 120 s before session 74). The
+    ellipsoid program between G and F gives B and a gain; V is that gain's Lyapunov
+    quadratic. B's sublevel set holds G and lies in F: checked at points of both."""
+    found = _reach_candidates(SAMPLED_CHAIN)
+    assert found and set(found[0].formulas) == {"V", "B"}, found
+    x, y, z = symbols = sympy.symbols("x y z")
+    B = to_sympy(found[0].formulas["B"], dict(zip("xyz", symbols)))
+    rng = np.random.default_rng(0)
+    for direction in rng.normal(size=(200, 3)):
+        unit = direction / np.linalg.norm(direction)
+        on_goal = dict(zip((x, y, z), 0.2 * unit))
+        past_final = dict(zip((x, y, z), 0.4 * unit))
+        assert B.subs(on_goal) <= 0 < B.subs(past_final)
+
+
+def test_the_ellipsoid_between_g_and_f_is_refused_where_no_gain_keeps_one():
+    """F barely larger than G: the program has no invariant ellipsoid between them."""
+    text = SAMPLED_CHAIN.read_text().replace("set F = ball([0, 0, 0], 0.4)",
+                                             "set F = ball([0, 0, 0], 0.21)")
+    plan = compile_spec(fossil_dsl.loads(text))
+    assert list(quadratic_roa.candidates(plan, float("inf"))) == []
+
+
+def test_continuous_reach_avoid_remain_with_functions_tries_the_quadratic_first():
+    """probe74/ax29 (exp in the field): the program for a polynomial stand-in took 19 s
+    where the linearisation's quadratic V and B are proved in under a second; polynomial
+    fields keep the program first."""
+    from fossil_dsl.engine import sos_reach
+    gain = compile_spec(fossil_dsl.load(ROOT / "specs/probe74/ax29_exp_gain_rar_3d.fsl"))
+    assert sos_reach.applies_late(gain) and not sos_reach.applies(gain)
+    polynomial = compile_spec(fossil_dsl.load(ROOT / "specs/rar_continuous.fsl"))
+    assert sos_reach.applies(polynomial) and not sos_reach.applies_late(polynomial)
+    result = fossil_dsl.synthesise(gain.spec, seed=0, timeout=60)
+    assert result.certified and result.strategy.startswith("the linearisation's quadratic V")
+
+
+def test_reach_and_stay_gets_v_and_its_level_from_the_linearisations_quadratic():
+    """probe74/ax35, a double integrator under -tanh(x + 2y): the reach program has no
+    polynomial stand-in for tanh over D (it saturates); before session 74 RSWA had no
+    quadratic attempt and was left to learning. V = k (x^T P x - level) with β just
+    inside F's boundary, so that {V <= β} lies in F."""
+    path = ROOT / "specs/probe74/ax35_tanh_policy_settle_far_limit.fsl"
+    found = _reach_candidates(path)
+    assert found and set(found[0].formulas) == {"V"} and "beta" in found[0].levels
+    x, y = symbols = sympy.symbols("x y")
+    V = to_sympy(found[0].formulas["V"], dict(zip("xy", symbols)))
+    beta = found[0].levels["beta"]
+    circle = np.linspace(0, 2 * np.pi, 100)
+    assert max(V.subs({x: 0.8 + 0.2 * np.cos(a), y: 0.2 * np.sin(a)}) for a in circle) <= 0
+    assert min(V.subs({x: 0.3 * np.cos(a), y: 0.3 * np.sin(a)}) for a in circle) > beta
+    result = fossil_dsl.synthesise(fossil_dsl.load(path), seed=0, timeout=60)
+    assert result.certified and result.strategy.startswith("the linearisation's quadratic V")
+
+
+def test_false_reach_and_stay_properties_get_no_candidate():
+    for name in ("f06_rswa_leaves", "f49_tanh_map_rswa_overshoot",
+                 "f112_final_set_beside_the_equilibrium_rswa", "f119_center_never_settles"):
         assert _reach_candidates(ROOT / "specs" / "false" / f"{name}.fsl") == [], name

@@ -66,16 +66,19 @@ def ellipsoid(A: np.ndarray, B: np.ndarray, spec, discrete: bool,
     return None if solve is None else _strongest(solve, discrete)
 
 
-def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool, vertices=()):
+def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool, vertices=(),
+               between=None):
     """ellipsoid()'s (P, K) for each of GAIN_WEIGHTS (the first alone without inputs):
     the later ones keep |u| smaller on the ellipsoid (a saturating tanh(u) near u); each
     followed by the strongest feasible rate, found by bisection, where that is another
     (the nonlinear terms need the larger margin: probe65/ao10, a planar quadrotor, has V
     growing at samples of the ellipsoid at a = 0.1 and none at 0.15 or 0.2, where s is
     over ROOM). `vertices`, pairs (A_i, B_i) of Jacobians elsewhere in D, ask the same
-    decay of each (a polytopic differential inclusion round the linearisation)."""
+    decay of each (a polytopic differential inclusion round the linearisation).
+    `between`, (inner, outer), puts the ellipsoid between other sets than I and D
+    (reach-avoid-remain's G and F)."""
     for weight in GAIN_WEIGHTS[:len(GAIN_WEIGHTS) if B.shape[1] else 1]:
-        solve = _solver(A, B, spec, discrete, weight, tuple(vertices))
+        solve = _solver(A, B, spec, discrete, weight, tuple(vertices), between)
         found = None if solve is None else _strongest(solve, discrete)
         if found is not None:
             yield found
@@ -84,19 +87,23 @@ def ellipsoids(A: np.ndarray, B: np.ndarray, spec, discrete: bool, vertices=()):
                 yield stronger
 
 
-def _solver(A, B, spec, discrete: bool, weight: float, vertices=()):
-    """rate -> (P, K, s) or None, for the spec's sets; None where they do not suit."""
-    half_widths = _half_widths(spec.domain, len(A))
-    initial = spec.property.role("initial")
+def _solver(A, B, spec, discrete: bool, weight: float, vertices=(), between=None):
+    """rate -> (P, K, s) or None, for the spec's sets (I and D, or `between`'s inner and
+    outer set); None where they do not suit."""
+    initial, outer = between or (spec.property.role("initial"), spec.domain)
+    # an outer ball round the origin holds the ellipsoid exactly when Q <= s R^2 I (its
+    # inscribed box asks sqrt(n) times less room: probe74/ax33's F)
+    outer_radius = _ball_radius(outer) if between else None
+    half_widths = np.full(len(A), np.inf) if outer_radius else _half_widths(outer, len(A))
     radius = _ball_radius(initial)
     corners = np.empty((0, len(A))) if radius else _corners(initial, len(A))
     if half_widths is None or corners is None:
         return None
-    planes = _unsafe_planes(spec)
+    planes = [] if between else _unsafe_planes(spec)
     # (cached: the strongest feasible rate's search goes over the listed rates again)
     return functools.lru_cache(maxsize=None)(
         lambda rate: _solve(A, B, half_widths, corners, radius, discrete, rate, planes,
-                            weight, vertices))
+                            weight, vertices, outer_radius))
 
 
 def _strongest(solve, discrete: bool):
@@ -199,7 +206,8 @@ def _corners(initial, n: int) -> np.ndarray | None:
 
 
 def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float,
-           planes=(), weight: float = GAIN_WEIGHTS[0], vertices=()):
+           planes=(), weight: float = GAIN_WEIGHTS[0], vertices=(),
+           outer_radius: float | None = None):
     n, m = B.shape
     lmi = _Inequalities(n)
     Q = lmi.symmetric(n)  # positive semidefinite
@@ -214,7 +222,10 @@ def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float,
                   if i == 0 else Q[i - 1][j - 1])
     lmi.block(m + n, lambda i, j: ({g: 1.0}, 0.0) if j < m and i == j else ({}, 0.0)
               if j < m else Y[i][j - m] if i < m else Q[i - m][j - m])
-    for i in range(n):
+    if outer_radius:  # s R^2 I - Q >= 0
+        lmi.block(n, lambda i, j: _sum([_scaled(Q[i][j], -1.0),
+                                        ({s: outer_radius ** 2} if i == j else {}, 0.0)]))
+    for i in range(n if not outer_radius else 0):
         forms, _ = Q[i][i]
         lmi.at_most.append(({**forms, s: -float(d[i]) ** 2}, 0.0))
     for a, b in planes:  # a^T Q a - s b^2 <= 0

@@ -176,9 +176,13 @@ def closed_loop(spec: CheckedSpec, controlled: bool, inputs=None, state_weight=N
             A = A - B @ K
     except (np.linalg.LinAlgError, ValueError):
         return None
-    stable = (np.abs(np.linalg.eigvals(A)) < 1).all() if discrete \
-        else (np.linalg.eigvals(A).real < 0).all()
-    return (A, K) if stable else None
+    return (A, K) if is_stable(A, discrete) else None
+
+
+def is_stable(A: np.ndarray, discrete: bool) -> bool:
+    """Every eigenvalue inside the unit circle (a map) or in the left half-plane."""
+    eigenvalues = np.linalg.eigvals(A)
+    return bool(np.all(np.abs(eigenvalues) < 1) if discrete else np.all(eigenvalues.real < 0))
 
 
 def lyapunov_matrix(A: np.ndarray, discrete: bool, decrease=None) -> np.ndarray | None:

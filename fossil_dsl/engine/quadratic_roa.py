@@ -17,26 +17,26 @@ Nothing here is trusted: V and β are proved like any candidate.
 from __future__ import annotations
 
 import itertools
-import math
 import time
 from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
 
-from fossil_dsl.engine.evaluate import holds, state_env
+from fossil_dsl.engine.ellipse_checks import (LEVEL_CUSHION, decreases, floats, level_between,
+                                              quadratic)
+from fossil_dsl.engine.reach_shapes import REMAIN_FORM, STAY_FORM, reach_formulas
+from fossil_dsl.engine.remain_shapes import remain_shapes
 from fossil_dsl.engine.sampling import sample
 from fossil_dsl.engine.trajectories import numeric_field
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
-from fossil_dsl.ir.sets import Boundary, Intersection
+from fossil_dsl.ir.sets import Intersection
 from fossil_dsl.ir.spec import TimeDomain
 from fossil_dsl.plan.compile import Plan, default_synthesis
 
 WEIGHTINGS = 6  # decreases Q asked of P for each gain: I, then random diagonal ones
 WEIGHT_SPREAD = 1.0  # their entries 10^u, u uniform in [-spread, spread]
-INSIDE, SHELL = 4000, 2000  # samples of Ω and of its boundary {V = β}
-LEVEL_CUSHION = 1.01  # β over the largest V on I (an upper bound worked out for I's shape)
 SIGNIFICANT = 6  # digits kept of P's entries
 # the ellipsoid asked to decay for the Jacobians this far towards each face of D, too
 # (after the linearisation's own): where the nonlinearity is strong on the ellipsoid
@@ -46,10 +46,9 @@ UNSAFE_SAMPLES = 2000  # of U within D (stable while avoid): V > β there
 FORMS = ("region of attraction", "stable while avoid")
 # and reach (while avoid) takes V = k (x^T P x - β): Ω lies in S, and outside G (round the
 # origin) V falls by at least γ once k is large enough
-# and RAR's B = x^T P x - b: b just over its largest value on G, {B <= 0} inside F
-REMAIN_FORM = "reach-avoid-remain"
-REACH_FORMS = ("reach while avoid", "reach", REMAIN_FORM)
-REACH_MARGIN = 10.0  # k makes V fall by this many times γ at the slowest sample of Ω \ G
+# and RAR's B = x^T P x - b: b just over its largest value on G, {B <= 0} inside F; RSWA
+# V as for reach with F for G, β just inside F (reach_shapes.py)
+REACH_FORMS = ("reach while avoid", "reach", REMAIN_FORM, STAY_FORM)
 
 
 @dataclass(frozen=True)
@@ -96,7 +95,7 @@ def candidates(plan: Plan, deadline: float):
     discrete = spec.time is TimeDomain.DISCRETE
     closed_loop, field = None, None
     deferred, yielded = [], False  # Ω reaching ∂D: only where no Ω inside D passes
-    for controller, gain, P in _shapes(plan, *found, operating, rng):
+    for controller, gain, P, remain in _shapes(plan, *found, operating, rng):
         if time.monotonic() > deadline:
             break
         if controller is not closed_loop:  # (the weightings of one gain share it)
@@ -104,17 +103,18 @@ def candidates(plan: Plan, deadline: float):
                 [traversal.substitute(f, controller) for f in spec.dynamics], plan.states)
         shape = None if P is None else _exact_shape(P)
         level, reaching = (None, False) if shape is None else _level(plan, shape)
-        if level is None or not _decreases(plan, field, shape, level, discrete, rng, reaching) \
+        if level is None or not decreases(plan, field, shape, level, discrete, rng, reaching) \
                 or not _misses_unsafe(plan, shape, level, rng):
             continue
         if plan.certificate.form in REACH_FORMS:
-            formulas = _reach_formulas(plan, field, shape, level, discrete, rng)
-            if formulas is not None:
+            found = reach_formulas(plan, field, shape, level, discrete, rng,
+                                   None if remain is None else _exact_shape(remain))
+            if found is not None:
                 yielded = True
-                yield QuadraticFinding(formulas, controller, gain, operating, {},
+                yield QuadraticFinding(found[0], controller, gain, operating, found[1],
                                        time.monotonic() - started)
             continue
-        V = _quadratic(shape, plan.states)
+        V = quadratic(shape, plan.states)
         formulas = {"V": V} if plan.certificate.form == FORMS[0] else \
             {"V": V, "B": E.add(V, E.Num(-level))}
         finding = QuadraticFinding(formulas, controller, gain, operating, {"beta": level},
@@ -129,22 +129,23 @@ def candidates(plan: Plan, deadline: float):
 
 
 def _shapes(plan: Plan, A: np.ndarray, B: np.ndarray, operating: np.ndarray, rng):
-    """(controller, its gain, P) in turn: the Lyapunov matrices of the first LQR gain's
-    closed loop (identity weights), the ellipsoid between I and D that the linearisation
-    keeps (ellipsoid_seed.py; where the LQR ellipsoids are flat, every sublevel set that
-    holds I leaves D; with inputs, again with a smaller gain), then the other LQR gains'
-    Lyapunov matrices."""
+    """(controller, its gain, P, RAR's own P for B or None) in turn: the Lyapunov
+    matrices of the first LQR gain's closed loop (identity weights), the ellipsoid
+    between I and D that the linearisation keeps (ellipsoid_seed.py; where the LQR
+    ellipsoids are flat, every sublevel set that holds I leaves D; with inputs, again
+    with a smaller gain), RAR's ellipsoids between G and F (remain_shapes.py), then the
+    other LQR gains' Lyapunov matrices."""
     from fossil_dsl.engine.ellipsoid_seed import ellipsoids
-    from fossil_dsl.engine.linear import lyapunov_matrix
+    from fossil_dsl.engine.linear import is_stable, lyapunov_matrix
     from fossil_dsl.engine.quadratic_shapes import exact_controller, lqr_controllers
     spec = plan.spec
     discrete = spec.time is TimeDomain.DISCRETE
     controllers = lqr_controllers(plan, operating, rng)
     for index, (controller, gain) in enumerate(controllers):
         closed = A if gain is None else A + B @ gain
-        if _stable(closed, discrete):  # (else no P: scipy warns of a centre's eigenvalues)
+        if is_stable(closed, discrete):  # (else no P: scipy warns of a centre's eigenvalues)
             for Q in _weightings(len(A), rng):
-                yield controller, gain, lyapunov_matrix(closed, discrete, Q)
+                yield controller, gain, lyapunov_matrix(closed, discrete, Q), None
         if index == 0:
             inputs = B if spec.inputs else np.zeros((len(A), 0))
             for P, K in itertools.chain(
@@ -152,7 +153,8 @@ def _shapes(plan: Plan, A: np.ndarray, B: np.ndarray, operating: np.ndarray, rng
                     ellipsoids(A, inputs, spec, discrete, _vertices(spec, operating))):
                 controller, gain = exact_controller(spec, K, operating, plan.options.digits) \
                     if spec.inputs else ({}, None)
-                yield controller, gain, P
+                yield controller, gain, P, None
+            yield from remain_shapes(plan, A, B, operating, _weightings(len(A), rng))
 
 
 def _vertices(spec, operating: np.ndarray):
@@ -173,18 +175,6 @@ def _vertices(spec, operating: np.ndarray):
     return found
 
 
-def _stable(A: np.ndarray, discrete: bool) -> bool:
-    eigenvalues = np.linalg.eigvals(A)
-    return bool(np.all(np.abs(eigenvalues) < 1) if discrete else np.all(eigenvalues.real < 0))
-
-
-def _quadratic(shape, states) -> E.Expr:
-    """x^T P x, each product once."""
-    return E.add(*(E.mul(E.Num(shape[i][j] * (1 if i == j else 2)),
-                         E.power(E.Var(a), E.Num(2)) if i == j else E.mul(E.Var(a), E.Var(b)))
-                   for i, a in enumerate(states) for j, b in enumerate(states)
-                   if j >= i and shape[i][j]))
-
 
 def _weightings(n: int, rng):
     yield np.eye(n)
@@ -197,11 +187,8 @@ def _exact_shape(P: np.ndarray) -> list[list[Fraction]] | None:
     matrix is not positive definite."""
     shape = [[Fraction(f"{P[min(i, j), max(i, j)]:.{SIGNIFICANT}g}") for j in range(len(P))]
              for i in range(len(P))]
-    return shape if np.linalg.eigvalsh(_floats(shape))[0] > 0 else None
+    return shape if np.linalg.eigvalsh(floats(shape))[0] > 0 else None
 
-
-def _floats(shape) -> np.ndarray:
-    return np.array([[float(v) for v in row] for row in shape])
 
 
 def _level(plan: Plan, shape) -> tuple[Fraction | None, bool]:
@@ -211,24 +198,13 @@ def _level(plan: Plan, shape) -> tuple[Fraction | None, bool]:
     origin that holds I: probe69/as10); else (None, False)."""
     from fossil_dsl.engine.quadratic_shapes import set_ceiling
     initial = plan.spec.property.role("initial")
-    level = _level_between(shape, initial, plan.spec.domain)
+    level = level_between(shape, initial, plan.spec.domain)
     if level is not None or plan.certificate.form not in FORMS \
             or plan.certificate.variant_conditions() is None:
         return level, False
-    ceiling = set_ceiling(_floats(shape), initial, np.zeros(len(shape)))
+    ceiling = set_ceiling(floats(shape), initial, np.zeros(len(shape)))
     return (None, False) if not ceiling else (Fraction(f"{ceiling * LEVEL_CUSHION:.3g}"), True)
 
-
-def _level_between(shape, inner, outer) -> Fraction | None:
-    """A level just over an upper bound of x^T P x on `inner` whose sublevel set lies
-    inside `outer` by the shapes' bounds (else None)."""
-    from fossil_dsl.engine.quadratic_shapes import boundary_floor, set_ceiling
-    P, centre = _floats(shape), np.zeros(len(shape))
-    ceiling = set_ceiling(P, inner, centre)
-    floor = boundary_floor(P, outer, centre)
-    if ceiling is None or floor is None or not 0 < ceiling * LEVEL_CUSHION < floor:
-        return None
-    return Fraction(f"{ceiling * LEVEL_CUSHION:.3g}")
 
 
 def _misses_unsafe(plan: Plan, shape, level: Fraction, rng) -> bool:
@@ -238,7 +214,7 @@ def _misses_unsafe(plan: Plan, shape, level: Fraction, rng) -> bool:
     unsafe = plan.spec.property.role("unsafe")
     if unsafe is None:
         return True
-    P = _floats(shape)
+    P = floats(shape)
     floor = set_floor(P, unsafe, np.zeros(len(P)))
     if floor is not None and floor <= level:
         return False
@@ -248,92 +224,6 @@ def _misses_unsafe(plan: Plan, shape, level: Fraction, rng) -> bool:
     return bool(np.all(np.einsum("bi,ij,bj->b", points, P, points) > float(level)))
 
 
-def _decreases(plan: Plan, field, shape, level: Fraction, discrete: bool, rng,
-               reaching: bool = False) -> bool:
-    """V decreases (and, for a map, f(x) stays in D) at samples of Ω and of its shell;
-    where Ω reaches ∂D, at those in D, and the field points into D on D's faces."""
-    P = _floats(shape)
-    points = _ellipsoid_points(P, float(level), rng)
-    if reaching:
-        from fossil_dsl.engine.quadratic_shapes import enters_box
-        points = points[_inside(plan, plan.spec.domain, points)]
-        if not enters_box(plan.spec.domain, field, P, float(level), points):
-            return False
-    change, image = _change(field, P, points, discrete)
-    if discrete and not np.all(_inside(plan, plan.spec.domain, image)):
-        return False
-    return bool(np.all(change < 0))
 
 
-def _change(field, P: np.ndarray, points: np.ndarray, discrete: bool):
-    """(x^T P x's change at the points: its step for a map, else its derivative; the
-    field's values there)."""
-    with np.errstate(all="ignore"):
-        image = field(points)
-        if discrete:
-            change = np.einsum("bi,ij,bj->b", image, P, image) - \
-                np.einsum("bi,ij,bj->b", points, P, points)
-        else:
-            change = 2 * np.einsum("bi,ij,bj->b", points, P, image)
-    return change, image
 
-
-def _inside(plan: Plan, region, points: np.ndarray) -> np.ndarray:
-    env = state_env(plan.states, np.nan_to_num(points, nan=1e9))
-    return np.asarray(holds(region.contains_formula(plan.states), env, len(points)), bool)
-
-
-def _reach_formulas(plan: Plan, field, shape, level: Fraction, discrete: bool, rng):
-    """{"V": V} (and RAR's "B") from the shape, or None where either fails its samples."""
-    V = _reaching(plan, field, shape, level, discrete, rng)
-    if V is None or plan.certificate.form != REMAIN_FORM:
-        return None if V is None else {"V": V}
-    B = _remaining(plan, field, shape, discrete, rng)
-    return None if B is None else {"V": V, "B": B}
-
-
-def _remaining(plan: Plan, field, shape, discrete: bool, rng):
-    """RAR's B = x^T P x - b, b just over its largest value on G, where {B <= 0} lies in F
-    and x^T P x falls at the samples of that set (and, for a map, each step from it
-    lands in D); else None."""
-    prop = plan.spec.property
-    level = _level_between(shape, prop.role("goal"), prop.role("final"))
-    if level is None or not _decreases(plan, field, shape, level, discrete, rng):
-        return None
-    return E.add(_quadratic(shape, plan.states), E.Num(-level))
-
-
-def _reaching(plan: Plan, field, shape, level: Fraction, discrete: bool, rng):
-    """k (x^T P x - β) with V's change at most -REACH_MARGIN γ at the samples of Ω
-    outside G, where G holds the origin and Ω (and, for a map, every step from it) lies
-    in S at the samples; else None."""
-    from fossil_dsl.plan.certificates.rwa import GAMMA
-    prop, P = plan.spec.property, _floats(shape)
-    safe, goal = prop.role("safe") or plan.spec.domain, prop.role("goal")
-    if not _inside(plan, goal, np.zeros((1, len(P))))[0]:
-        return None  # V would have to fall by γ next to the equilibrium
-    # V falls slowest next to G: its boundary's samples too
-    edge = np.asarray(sample(Boundary(goal), plan.states, SHELL, rng,
-                             plan.spec.domain.bounding_box()), float).reshape(-1, len(P))
-    edge = edge[np.einsum("bi,ij,bj->b", edge, P, edge) <= float(level)]
-    points = _ellipsoid_points(P, float(level), rng)
-    points = np.concatenate([points[~_inside(plan, goal, points)], edge])
-    change, image = _change(field, P, points, discrete)
-    if not (np.all(_inside(plan, safe, points)) and len(points) and np.all(change < 0)):
-        return None
-    if discrete and not np.all(_inside(plan, safe, image)):
-        return None
-    k = Fraction(f"{REACH_MARGIN * float(GAMMA) / float(-change.max()):.3g}")
-    scaled = [[k * entry for entry in row] for row in shape]
-    return E.add(_quadratic(scaled, plan.states), E.Num(-k * level))
-
-
-def _ellipsoid_points(P: np.ndarray, level: float, rng) -> np.ndarray:
-    """Uniform samples of {x^T P x <= level} and of its boundary (none at the origin)."""
-    n = len(P)
-    directions = rng.normal(size=(INSIDE + SHELL, n))
-    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    radii = np.concatenate([rng.uniform(1e-6, 1, INSIDE) ** (1 / n), np.ones(SHELL)])
-    # x = sqrt(level) L^-T u for P = L L^T maps the unit ball onto the ellipsoid
-    L = np.linalg.cholesky(P)
-    return math.sqrt(level) * np.linalg.solve(L.T, (radii[:, None] * directions).T).T

@@ -120,7 +120,8 @@ def applies_late(plan: Plan) -> bool:
     of degree 4 for maps with stand-ins) cost up to 16 s first (probe64/am04: 4.6 ->
     16 s); the programs certify where no ellipsoid fits (probe70/at31)."""
     return (plan.certificate.form == "reach-avoid-remain" and default_synthesis(plan)
-            and plan.spec.time is TimeDomain.DISCRETE)
+            and (plan.spec.time is TimeDomain.DISCRETE
+                 or not all(map(traversal.is_arithmetic, plan.spec.dynamics))))
 
 
 def search(plan: Plan, deadline: float) -> ReachFinding | None:
