@@ -472,3 +472,32 @@ def test_a_rational_field_whose_denominator_changes_sign_on_d_gets_no_barrier():
     plan = compile_spec(fossil_dsl.loads(text))
     assert sos.applies(plan)
     assert sos_barrier.barrier(plan, time.monotonic() + 30) is None
+
+
+SPRING_CHAIN = Path(__file__).resolve().parent.parent / \
+    "specs/probe72/av32_cubic_spring_chain_safety_6d.fsl"
+
+
+def test_a_quartic_barrier_too_large_in_full_is_sought_quartic_in_the_nonlinear_states():
+    """probe72/av32, three masses on cubic springs (6 states): the full quartic barrier
+    program (10 333 variables) exceeds its cap, and nothing was found in 120 s before
+    session 74. B quartic in the positions and quadratic in the speeds, an energy's
+    shape: the program is a quarter of the size and finds B; the kernel proves it."""
+    plan = compile_spec(fossil_dsl.load(SPRING_CHAIN))
+    basis = sos_barrier._nonlinear_part_basis(
+        sos_barrier.exact_field(plan, plan.spec.dynamics).numerators, 6, 2)
+    speeds = {m for m in basis if sum(m[3:]) > 0}
+    assert max(sum(m) for m in speeds) == 2  # v1..v3 enter linearly in the field
+    assert max(sum(m) for m in basis) == 4 and len(basis) < 210
+    found = sos_barrier.barrier(plan, time.monotonic() + 60)
+    assert found is not None and found.degree == 4
+    result = fossil_dsl.synthesise(fossil_dsl.load(SPRING_CHAIN), seed=0, timeout=90)
+    assert result.certified and result.strategy.startswith("sum-of-squares"), result.reason
+
+
+def test_a_linear_field_gets_no_second_program_of_the_quadratic_basis():
+    plan = _plan(THREE_STATES.replace("x' = -x + y*z - x^3", "x' = -x")
+                 .replace("y' = -2*y - x*z", "y' = -2*y").replace("z' = -z + x*y - z^3",
+                                                                  "z' = -z"))
+    numerators = sos_barrier.exact_field(plan, plan.spec.dynamics).numerators
+    assert max(map(sum, sos_barrier._nonlinear_part_basis(numerators, 3, 2))) == 2
