@@ -501,3 +501,26 @@ def test_a_linear_field_gets_no_second_program_of_the_quadratic_basis():
                                                                   "z' = -z"))
     numerators = sos_barrier.exact_field(plan, plan.spec.dynamics).numerators
     assert max(map(sum, sos_barrier._nonlinear_part_basis(numerators, 3, 2))) == 2
+
+
+FOUR_MASSES = Path(__file__).resolve().parent.parent / \
+    "specs/probe48/c05_four_mass_chain_8d_stable.fsl"
+
+
+def test_an_eight_state_spring_chain_gets_an_energy_shaped_quartic_v():
+    """probe48/c05, four masses on hardening springs (8 states), `prove stable` on the
+    box: no quadratic V decreases on D, the full quartic program (30 361 variables) is
+    over the bound, and learning timed out (open since session 48). V's terms above
+    degree 2 in the positions only (an energy plus cross terms): 2 557 variables."""
+    plan = compile_spec(fossil_dsl.load(FOUR_MASSES))
+    field = sos.field_of(plan)
+    assert sos.nonlinear_states(field, 8) == {0, 2, 4, 6}  # q1..q4, not the speeds
+    plain = sos.set_constraints(plan.spec.domain, plan.states)
+    full = sos._LyapunovProgram(8, field, plain, 2, 1, False)
+    shaped = sos._LyapunovProgram(8, field, plain, 2, 1, False, sos.nonlinear_states(field, 8))
+    assert full.count > sos.MAX_VARIABLES >= shaped.count
+    result = fossil_dsl.synthesise(fossil_dsl.load(FOUR_MASSES), seed=0, timeout=110)
+    assert result.certified and result.strategy.startswith("sum-of-squares"), result.reason
+    V = result.sympy["V"]
+    speeds = [s for s in V.free_symbols if str(s).startswith("v")]
+    assert all(sympy.degree(V, s) <= 2 for s in speeds)

@@ -21,7 +21,8 @@ import time
 from fractions import Fraction
 
 from fossil_dsl.engine.polynomial_field import exact_field, padded, widened
-from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, faces, interval_products, rounded,
+from fossil_dsl.engine.sos import (MIN_MARGIN, SosFinding, energy_shaped, faces,
+                                   interval_products, nonlinear_states, rounded,
                                    set_constraints, set_pieces)
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir.spec import TimeDomain
@@ -145,12 +146,9 @@ class BarrierProgram(Program):
 
 def _nonlinear_part_basis(field, states: int, degree: int) -> list[P.Monomial]:
     """B's monomials of degree at most 2 in every state and up to 2 * degree in the
-    states of the field's nonlinear terms only: an energy's shape, quadratic in the
-    speeds and of higher degree in the positions that cubic springs act on. Its change
-    along the field has a lower degree, and the flow condition's program is a quarter
-    of the full one (probe72/av32, a 6-state chain of cubic springs: 10 333 variables
-    and 53 s for the quartic B; 2 476 and 0.8 s for this one)."""
-    nonlinear = {i for p in field for m in p if sum(m[:states]) >= 2
-                 for i, e in enumerate(m[:states]) if e}
-    return [m for m in P.monomials(states, 0, 2 * degree)
-            if sum(m) <= 2 or all(e == 0 or i in nonlinear for i, e in enumerate(m))]
+    states of the field's nonlinear terms only (sos.energy_shaped): its change along the
+    field has a lower degree, and the flow condition's program is a quarter of the full
+    one (probe72/av32, a 6-state chain of cubic springs: 10 333 variables and 53 s for
+    the quartic B; 2 476 and 0.8 s for this one)."""
+    nonlinear = nonlinear_states(field, states)
+    return [m for m in P.monomials(states, 0, 2 * degree) if energy_shaped(m, nonlinear)]
