@@ -38,6 +38,9 @@ DEGREES = (1, 2, 3)
 # probe72/av37 (4 states, U outside a box: 8 pieces) has a quartic B from a program of
 # 3 611 variables, solved in about 1 s
 HIGHER_DEGREE_MAX_VARIABLES = 4000
+# an energy-shaped B's (_nonlinear_part_basis): probe74/ax37, four masses on cubic springs
+# in 8 states, has one from a program of 5 771 variables (about 5 s a decay rate)
+ENERGY_MAX_VARIABLES = 8000
 DECAY_RATES = (1.0, 0.1, 10.0)  # mu, in the order tried
 # for a map, B(f(x)) - B(x) <= -mu B(x) - e: B(f(x)) <= (1 - mu) B(x) <= 0 where B <= 0
 # needs mu <= 1
@@ -76,22 +79,18 @@ def barrier(plan: Plan, deadline: float, dynamics=None, min_margin: float = MIN_
     # applications took 8 s (bbu09)
     degrees = DEGREES if degrees is None else degrees
     for degree in (d for d in degrees if not facts or d == DEGREES[0]):
-        for mu in MAP_DECAY_RATES if discrete else DECAY_RATES:
+        bases = _bases(field, len(states), degree)
+        fitting = False  # a program of this degree within its bound
+        for mu, (basis, largest) in ((m, b) for m in (MAP_DECAY_RATES if discrete
+                                                      else DECAY_RATES) for b in bases):
             if time.monotonic() > deadline:
                 return None
-            largest = ATOMS_MAX_VARIABLES if facts else \
-                MAX_VARIABLES if degree == 1 else HIGHER_DEGREE_MAX_VARIABLES
-            program = None
-            smaller = _nonlinear_part_basis(field.numerators, len(states), degree)
-            # (a linear field's is the quadratic basis, whose program failed already)
-            for basis in (None, smaller) if max(map(sum, smaller)) > 2 else (None,):
-                program = BarrierProgram(n, field.numerators, initial, unsafe, domain,
-                                         degree, mu, field.denominator, len(states),
-                                         discrete, basis)
-                if program.count <= largest:
-                    break
+            program = BarrierProgram(n, field.numerators, initial, unsafe, domain,
+                                     degree, mu, field.denominator, len(states),
+                                     discrete, basis)
             if program.count > largest:
-                return None
+                continue
+            fitting = True
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
             if x is None or x[program.margin] <= min_margin:
                 continue
@@ -104,7 +103,23 @@ def barrier(plan: Plan, deadline: float, dynamics=None, min_margin: float = MIN_
                               f"margin {margin:.3g}" + (" (the field's functions bounded "
                                                        "by their facts)" if facts else ""),
                               time.monotonic() - started)
+        if not fitting:
+            return None  # (the next degree's programs are larger still)
     return None
+
+
+def _bases(field, states: int, degree: int) -> list:
+    """(B's monomials or None for all of the degree, the program's bound on variables):
+    above degree 1, where only some states enter the field's nonlinear terms, the
+    energy-shaped ones first (their programs are a fraction of the size), then all."""
+    if field.facts:
+        return [(None, ATOMS_MAX_VARIABLES)]
+    if degree == 1:
+        return [(None, MAX_VARIABLES)]
+    smaller = _nonlinear_part_basis(field.numerators, states, degree)
+    shaped = max(map(sum, smaller)) > 2 and len(smaller) < len(P.monomials(states, 0, 2 * degree))
+    return ([(smaller, ENERGY_MAX_VARIABLES)] if shaped else []) + \
+        [(None, HIGHER_DEGREE_MAX_VARIABLES)]
 
 
 class BarrierProgram(Program):
