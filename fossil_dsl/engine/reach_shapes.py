@@ -52,7 +52,6 @@ def _reaching(plan, field, shape, level: Fraction, discrete: bool, rng):
     """k (x^T P x - β) with V's change at most -REACH_MARGIN γ at the samples of Ω
     outside G, where G holds the origin and Ω (and, for a map, every step from it) lies
     in S at the samples; else None."""
-    from fossil_dsl.plan.certificates.rwa import GAMMA
     prop, P = plan.spec.property, floats(shape)
     safe, goal = prop.role("safe") or plan.spec.domain, prop.role("goal")
     if not inside(plan, goal, np.zeros((1, len(P))))[0]:
@@ -68,9 +67,7 @@ def _reaching(plan, field, shape, level: Fraction, discrete: bool, rng):
         return None
     if discrete and not np.all(inside(plan, safe, image)):
         return None
-    k = Fraction(f"{REACH_MARGIN * float(GAMMA) / float(-rates.max()):.3g}")
-    scaled = [[k * entry for entry in row] for row in shape]
-    return E.add(quadratic(scaled, plan.states), E.Num(-k * level))
+    return _falling(plan, shape, level, rates)[1]
 
 
 def _staying(plan, field, shape, level: Fraction, discrete: bool, rng):
@@ -80,7 +77,6 @@ def _staying(plan, field, shape, level: Fraction, discrete: bool, rng):
     outside it (and on its boundary), and Ω (for a map, each step from it) lies in S;
     else None."""
     from fossil_dsl.engine.quadratic_shapes import boundary_floor
-    from fossil_dsl.plan.certificates.rwa import GAMMA
     prop, P = plan.spec.property, floats(shape)
     safe, final = prop.role("safe") or plan.spec.domain, prop.role("final")
     floor = boundary_floor(P, final, np.zeros(len(P)))
@@ -98,7 +94,14 @@ def _staying(plan, field, shape, level: Fraction, discrete: bool, rng):
         return None
     if discrete and not np.all(inside(plan, safe, image)):
         return None
-    k = Fraction(f"{REACH_MARGIN * float(GAMMA) / float(-rates[:len(outer)].max()):.3g}")
+    k, V = _falling(plan, shape, level, rates[:len(outer)])
+    return {"V": V}, {"beta": k * (inner - level)}
+
+
+def _falling(plan, shape, level: Fraction, rates) -> tuple[Fraction, E.Expr]:
+    """(k, k (x^T P x - level)) with k such that V falls by REACH_MARGIN γ at the slowest
+    of the rates."""
+    from fossil_dsl.plan.certificates.rwa import GAMMA
+    k = Fraction(f"{REACH_MARGIN * float(GAMMA) / float(-rates.max()):.3g}")
     scaled = [[k * entry for entry in row] for row in shape]
-    return ({"V": E.add(quadratic(scaled, plan.states), E.Num(-k * level))},
-            {"beta": k * (inner - level)})
+    return k, E.add(quadratic(scaled, plan.states), E.Num(-k * level))
