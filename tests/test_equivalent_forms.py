@@ -144,3 +144,20 @@ def test_reach_avoid_remain_beside_an_obstacle_is_the_linearisations_ellipse():
     spec = fossil_dsl.load(SPECS / "probe73/aw30_map_reach_avoid_never.fsl")
     result = fossil_dsl.synthesise(spec, timeout=60)
     assert result.certified and "linearisation" in result.strategy
+
+
+def test_two_limits_written_as_two_nots_are_certified_end_to_end():
+    """probe74/ax04: `not eventually hot and not eventually cold`, refused as an
+    unsupported property before session 74; now safety with U = hot | cold."""
+    result = fossil_dsl.synthesise(
+        fossil_dsl.load(SPECS / "probe74/ax04_reactor_neither_hot_nor_cold.fsl"), timeout=60)
+    assert result.certified, result.reason
+    unsafe = result.to_json()["property"]["roles"]["unsafe"]
+    assert "hot" in unsafe and "cold" in unsafe
+
+
+def test_an_orbit_through_the_second_obstacle_is_not_certified():
+    result = fossil_dsl.synthesise(
+        fossil_dsl.load(SPECS / "false/f122_rotation_through_pit_two_obstacles.fsl"),
+        timeout=20)
+    assert not result.certified
