@@ -527,20 +527,23 @@ def test_an_eight_state_spring_chain_gets_an_energy_shaped_quartic_v():
     assert all(sympy.degree(V, s) <= 2 for s in speeds)
 
 
-def test_the_energy_shaped_program_comes_first_and_may_be_larger_than_the_full_bound():
+def test_the_energy_shaped_program_comes_where_the_full_one_is_large():
     """probe74/ax37, four masses on cubic springs to ground (8 states): its energy-shaped
     quartic B needs 5 771 variables, over the full programs' bound of 4 000 (certified
     in 48 s since session 74, a timeout before); ax36, three masses' region of
     attraction: the energy-shaped V's program (1 009 variables) before the full one
-    (8 401, too costly to start in the attempt's time)."""
+    (8 401, too costly to start in the attempt's time); a small full program alone."""
     plan = compile_spec(fossil_dsl.load(SPECS74 / "ax37_four_mass_chain_safety_8d.fsl"))
     field = sos_barrier.exact_field(plan, plan.spec.dynamics)
-    (shaped, cap), (full, full_cap) = sos_barrier._bases(field, 8, 2)
+    (full, full_cap), (shaped, cap) = sos_barrier._bases(field, 8, 2)
     assert full is None and cap > full_cap and max(map(sum, shaped)) == 4
     spec = fossil_dsl.load(SPECS74 / "ax36_three_mass_cubic_chain_roa_6d.fsl")
-    programs = list(sos._programs(compile_spec(spec), sos.field_of(compile_spec(spec)),
-                                  [], 2, 1))
+    plan = compile_spec(spec)
+    programs = list(sos._programs(plan, sos.field_of(plan),
+                                  sos.set_constraints(plan.spec.domain, plan.states), 2, 1))
     assert programs[0].nonlinear == {0, 1, 2} and programs[1].nonlinear is None
     assert programs[0].count < programs[1].count / 4
+    small = list(sos._programs(_plan(THREE_STATES), sos.field_of(_plan(THREE_STATES)), [], 2, 1))
+    assert len(small) == 1 and small[0].nonlinear is None
     result = fossil_dsl.synthesise(spec, seed=0, timeout=60)
     assert result.certified and result.strategy.startswith("sum-of-squares"), result.reason

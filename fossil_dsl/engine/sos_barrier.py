@@ -80,17 +80,19 @@ def barrier(plan: Plan, deadline: float, dynamics=None, min_margin: float = MIN_
     degrees = DEGREES if degrees is None else degrees
     for degree in (d for d in degrees if not facts or d == DEGREES[0]):
         bases = _bases(field, len(states), degree)
-        fitting = False  # a program of this degree within its bound
-        for mu, (basis, largest) in ((m, b) for m in (MAP_DECAY_RATES if discrete
-                                                      else DECAY_RATES) for b in bases):
+        for mu in MAP_DECAY_RATES if discrete else DECAY_RATES:
             if time.monotonic() > deadline:
                 return None
-            program = BarrierProgram(n, field.numerators, initial, unsafe, domain,
-                                     degree, mu, field.denominator, len(states),
-                                     discrete, basis)
-            if program.count > largest:
-                continue
-            fitting = True
+            program = None
+            for basis, largest in bases:  # the first whose program is within its bound
+                program = BarrierProgram(n, field.numerators, initial, unsafe, domain,
+                                         degree, mu, field.denominator, len(states),
+                                         discrete, basis)
+                if program.count <= largest:
+                    break
+                program = None
+            if program is None:
+                return None  # (the next degree's programs are larger still)
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
             if x is None or x[program.margin] <= min_margin:
                 continue
@@ -103,23 +105,23 @@ def barrier(plan: Plan, deadline: float, dynamics=None, min_margin: float = MIN_
                               f"margin {margin:.3g}" + (" (the field's functions bounded "
                                                        "by their facts)" if facts else ""),
                               time.monotonic() - started)
-        if not fitting:
-            return None  # (the next degree's programs are larger still)
     return None
 
 
 def _bases(field, states: int, degree: int) -> list:
     """(B's monomials or None for all of the degree, the program's bound on variables):
-    above degree 1, where only some states enter the field's nonlinear terms, the
-    energy-shaped ones first (their programs are a fraction of the size), then all."""
+    all, then, above degree 1 where only some states enter the field's nonlinear terms,
+    the energy-shaped ones (whose programs are a fraction of the size, with a larger
+    bound)."""
     if field.facts:
         return [(None, ATOMS_MAX_VARIABLES)]
     if degree == 1:
         return [(None, MAX_VARIABLES)]
     smaller = _nonlinear_part_basis(field.numerators, states, degree)
     shaped = max(map(sum, smaller)) > 2 and len(smaller) < len(P.monomials(states, 0, 2 * degree))
-    return ([(smaller, ENERGY_MAX_VARIABLES)] if shaped else []) + \
-        [(None, HIGHER_DEGREE_MAX_VARIABLES)]
+    # the full program first: where it is within its bound the shaped one adds nothing
+    return [(None, HIGHER_DEGREE_MAX_VARIABLES)] + \
+        ([(smaller, ENERGY_MAX_VARIABLES)] if shaped else [])
 
 
 class BarrierProgram(Program):
