@@ -229,3 +229,37 @@ def test_no_power_makes_logs_of_opposite_signs_defined_at_zero():
     assert first_integral._power_scale([Fraction(1), Fraction(-1)]) is None
     assert first_integral._power_scale([Fraction(5)]) == Fraction(1, 5)
     assert first_integral._power_scale([Fraction(1), Fraction(7)]) is None  # x y^7
+
+
+def test_shifted_lotka_volterra_is_certified_with_the_logs_of_its_invariant_lines(tmp_path):
+    # probe75/ay34: u' = -(1 + u) v, v' = (1 + v) u conserves u - log(1 + u) + v - log(1 + v);
+    # 1 + u divides u's own equation, so u = -1 is invariant and log(1 + u) a candidate
+    spec = fossil_dsl.load(ROOT / "specs/probe75/ay34_lotka_volterra_cycle_safety.fsl")
+    result = fossil_dsl.synthesise(spec, timeout=60)
+    assert result.certified, result.summary()
+    assert result.strategy.startswith("a conserved quantity")
+    assert "log(u + 1)" in E.to_text(result.formulas["B"])
+    result.save(tmp_path)
+    checks = recheck(tmp_path, timeout=30)
+    assert checks and all(c.reproved for c in checks), checks
+
+
+def test_a_log_of_a_factor_is_a_candidate_only_where_it_keeps_one_sign_on_d():
+    u, v = E.Var("u"), E.Var("v")
+    one_plus = lambda s: E.add(s, E.ONE)  # noqa: E731
+    field = [E.mul(E.Num(-1), one_plus(u), v), E.mul(one_plus(v), u)]
+    found = first_integral._invariant_logs(field, ["u", "v"], ([-0.9, -0.9], [3, 3]))
+    assert set(found) == {E.apply("log", one_plus(u)), E.apply("log", one_plus(v))}
+    assert found[E.apply("log", one_plus(u))] == E.mul(E.Num(-1), v)
+    # D reaches u = -1: log(1 + u) is undefined there, and no longer a candidate
+    assert list(first_integral._invariant_logs(field, ["u", "v"], ([-1.2, -0.9], [3, 3]))) \
+        == [E.apply("log", one_plus(v))]
+    # u's equation without the factor: nothing
+    assert first_integral._invariant_logs([v, u], ["u", "v"], ([-0.9, -0.9], [3, 3])) == {}
+
+
+def test_a_false_property_of_the_shifted_lotka_volterra_cycle_is_not_certified():
+    spec = fossil_dsl.load(ROOT / "specs/false/f133_lotka_volterra_cycle_reaches_low_prey.fsl")
+    assert first_integral.search(compile_spec(spec), float("inf")) is None
+    result = fossil_dsl.synthesise(spec, timeout=10, max_iters=3)
+    assert not result.certified

@@ -225,9 +225,10 @@ def _solve(A, B, d, corners, radius: float | None, discrete: bool, rate: float,
     if outer_radius:  # s R^2 I - Q >= 0
         lmi.block(n, lambda i, j: _sum([_scaled(Q[i][j], -1.0),
                                         ({s: outer_radius ** 2} if i == j else {}, 0.0)]))
-    for i in range(n if not outer_radius else 0):
-        forms, _ = Q[i][i]
-        lmi.at_most.append(({**forms, s: -float(d[i]) ** 2}, 0.0))
+    if not outer_radius:  # Q_ii <= s d_i^2
+        for i in range(n):
+            forms, _ = Q[i][i]
+            lmi.at_most.append(({**forms, s: -float(d[i]) ** 2}, 0.0))
     for a, b in planes:  # a^T Q a - s b^2 <= 0
         lmi.at_most.append((_sum([_scaled(Q[i][j], a[i] * a[j]) for i in range(n)
                                   for j in range(n)] + [({s: -b ** 2}, 0.0)])[0], 0.0))

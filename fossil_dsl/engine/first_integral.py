@@ -1,7 +1,8 @@
 """Conserved quantities as barriers, for safety.
 
 The combinations H of a few functions (the monomials of degree 1..d, sin and cos of each
-argument of a sin or cos in the field, log of each state positive on D) with dH/dt = 0 along x' = f(x) (H(f(x)) =
+argument of a sin or cos in the field, log of each state positive on D, and log |x + c|
+where x + c divides x's own equation and keeps one sign on D) with dH/dt = 0 along x' = f(x) (H(f(x)) =
 H(x) for a map) form a linear space: written over the states and the field's atoms as
 indeterminates (ir/atoms.py), the conditions are linear equations in H's coefficients
 with rational entries, so the space is found exactly (python-flint's integer null
@@ -88,12 +89,14 @@ def search(plan: Plan, deadline: float, extra=None) -> ConservedFinding | None:
     box = spec.domain.bounding_box()
     positive = [s for s, low in zip(states, box[0]) if low > 0] if box else []
     touching = [s for s, low in zip(states, box[0]) if low == 0] if box else []
+    discrete = spec.time is TimeDomain.DISCRETE
+    shifted = _invariant_logs(field, states, box) if box and not discrete else {}
     samples = None
     for degree, at_zero in _passes(touching):
-        candidates = _candidates(field, states, degree, positive + at_zero)
+        candidates = _candidates(field, states, degree, positive + at_zero) + list(shifted)
         if time.monotonic() > deadline or len(candidates) > MAX_BASIS:
             return None
-        weights = _null_space(candidates, field, states, spec.time is TimeDomain.DISCRETE)
+        weights = _null_space(candidates, field, states, discrete, shifted)
         basis = [_defined_on_zero(w, candidates, at_zero) for w in weights]
         basis = [h for h in basis if h is not None]
         if not basis:
@@ -117,6 +120,43 @@ def _candidates(field, states, degree: int, positive=()) -> list[E.Expr]:
                               if isinstance(node, E.Apply) and node.func in ("sin", "cos"))
     return monomials + [E.apply(func, a) for a in arguments for func in ("sin", "cos")] + \
         [E.apply("log", E.Var(s)) for s in positive]
+
+
+def _invariant_logs(field, states, box) -> dict[E.Expr, E.Expr]:
+    """log |x + c| for each factor x + c (c != 0) of x's own polynomial equation x' = f that
+    keeps one sign on D's box, with its change f / (x + c), a polynomial: x = -c is then
+    invariant (x + c is a Darboux polynomial), and the log of such factors is how the
+    shifted Lotka-Volterra system conserves u - log(1 + u) + v - log(1 + v)."""
+    import sympy
+    from fossil_dsl.ir.symbolic import from_sympy, to_sympy
+    symbols = {s: sympy.Symbol(s) for s in states}
+    logs = {}
+    for state, f, low, high in zip(states, field, *box):
+        x = symbols[state]
+        try:
+            factors = sympy.factor_list(to_sympy(f, symbols), x)[1]
+        except sympy.PolynomialError:  # not a polynomial in x
+            continue
+        for factor, _ in factors:
+            c = _shift(factor, x)
+            if c is not None and c != 0 and (low + c > 0 or high + c < 0):
+                sign = 1 if low + c > 0 else -1
+                log = E.apply("log", E.mul(E.Num(sign), E.add(E.Var(state), E.Num(c))))
+                quotient = sympy.cancel(to_sympy(f, symbols) / (x + sympy.Rational(c)))
+                logs[log] = from_sympy(quotient, states)
+    return logs
+
+
+def _shift(factor, x) -> Fraction | None:
+    """c where the factor is a (x + c) with a and c rational numbers, else None."""
+    import sympy
+    if factor.free_symbols != {x}:
+        return None
+    poly = sympy.Poly(factor, x)
+    if poly.degree() != 1 or not all(k.is_Rational for k in poly.all_coeffs()):
+        return None
+    a, b = poly.all_coeffs()
+    return Fraction(int(sympy.numer(b / a)), int(sympy.denom(b / a)))
 
 
 def _passes(touching: list[str]):
@@ -143,7 +183,9 @@ def _defined_on_zero(weights: list[Fraction], candidates, at_zero: list[str]):
 
 
 def _is_log(candidate: E.Expr) -> bool:
-    return isinstance(candidate, E.Apply) and candidate.func == "log"
+    """The log of a state itself (not log |x + c|, whose argument keeps away from 0)."""
+    return isinstance(candidate, E.Apply) and candidate.func == "log" and \
+        isinstance(candidate.arg, E.Var)
 
 
 def _power_scale(coefficients: list[Fraction]) -> Fraction | None:
@@ -168,11 +210,15 @@ def conserved(candidates, field, states, discrete: bool) -> list[E.Expr]:
             for w in _null_space(candidates, field, states, discrete)]
 
 
-def _null_space(candidates, field, states, discrete: bool) -> list[list[Fraction]]:
+def _null_space(candidates, field, states, discrete: bool,
+                known=None) -> list[list[Fraction]]:
     """The weights of conserved combinations of the candidates (a basis, each scaled to
-    largest weight 1)."""
+    largest weight 1); `known`: candidate -> its change, where that is simpler than
+    calculus.change's (log |x + c|: a polynomial)."""
     import flint
-    changes = [calculus.change(c, states, field, discrete) for c in candidates]
+    known = known or {}
+    changes = [known[c] if c in known else calculus.change(c, states, field, discrete)
+               for c in candidates]
     try:
         polynomials = AtomTable(states).polynomials(changes)
     except P.NotPolynomial:  # (a power with a symbolic exponent inside an atom's argument)

@@ -91,7 +91,8 @@ def lyapunov(plan: Plan, deadline: float) -> SosFinding | None:
         for program in _programs(plan, field, variants[variant], degree, power,
                                  full=variant not in too_large):
             if program.count > MAX_VARIABLES:
-                too_large.update([variant] if program.nonlinear is None else [])
+                if program.nonlinear is None:
+                    too_large.add(variant)
                 continue
             x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
             if x is not None and x[program.margin] > MIN_MARGIN:
