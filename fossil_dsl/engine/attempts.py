@@ -1,8 +1,8 @@
-"""What a run tries, in order: for `region: largest` a V shaped to the basin; for safety a
-conserved quantity's barrier, then one round a repelling equilibrium in U; a
-sum-of-squares certificate where the system is polynomial (each proved by proving.py),
-then the learning loop with the time left. Whatever is tried, the kernel judges the final
-formulas (and checks any refutation) alone."""
+"""What a run tries, in order (an unstable origin's stability refuted first): for `region:
+largest` a V shaped to the basin; for safety a conserved quantity's barrier, then one
+round a repelling equilibrium in U; a sum-of-squares certificate where the system is
+polynomial (each proved by proving.py), then the learning loop with the time left.
+Whatever is tried, the kernel judges the final formulas (and checks any refutation) alone."""
 from __future__ import annotations
 
 import functools
@@ -13,7 +13,7 @@ import numpy as np
 from dataclasses import replace
 
 from fossil_dsl.engine import (basin, first_integral, quadratic_roa, repelling, sos,
-                               sos_controlled, sos_reach, sos_roa, swa_parts)
+                               sos_controlled, sos_reach, sos_roa, swa_parts, unstable_origin)
 from fossil_dsl.engine.learning import learn, learn_briefly, learning_imported
 from fossil_dsl.engine.proving import (SOS_QUERY_SECONDS, NotSetUp, budgets, only_function,
                                        prove_found, verify_given)
@@ -59,6 +59,8 @@ def run_attempts(plan: Plan, backend: Backend | None, progress=None) -> tuple[Pl
     """The plan that was run (a found function becomes its candidate) and its outcome."""
     listener = as_listener(progress)
     deadline = time.monotonic() + plan.options.timeout
+    if (refuted := unstable_origin.refutation(plan)) is not None:
+        return plan, unstable_origin.refuted_outcome(plan, refuted)
     notes = []
     for applies, attempt in ((basin.applies, _shaped_to_basin),
                              (first_integral.applies, _conserved),

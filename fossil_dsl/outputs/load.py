@@ -47,7 +47,9 @@ def load_result(directory: str | Path, judge_again: bool = True, timeout: float 
         not_certified("loaded without judging (judge_again=False); result.json says "
                       f"{data.get('verdict')!r}")
     seconds = data.get("seconds", {})
-    return Result(plan, verdict.certified, data.get("reason", "") if verdict.certified
+    # a run that was not certified keeps its own reason (a property refuted, say)
+    own = verdict.certified or data.get("verdict") != "certified"
+    return Result(plan, verdict.certified, data.get("reason", "") if own
                   else verdict.reason, formulas, controller, levels,
                   tuple(_condition(c) for c in data.get("conditions", [])),
                   _obligations(folder), int(data.get("iterations", 0)),

@@ -177,6 +177,9 @@ def _solvers_used(data: dict) -> dict[str, str]:
 
 def _derive(data: dict):
     """The checked spec from its text, and the kernel's obligations for the formulas."""
+    if not data.get("functions"):  # a property refuted before any function was sought
+        raise RecheckError(f"nothing to re-prove: the run found no function "
+                           f"({data.get('reason', 'no reason recorded')})")
     spec = checked_spec(data)
     claim = Claim(spec, read_formulas(data.get("functions", {}), spec.states),
                   read_formulas(data.get("controller", {}), spec.states),
