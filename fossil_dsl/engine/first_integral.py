@@ -2,11 +2,11 @@
 
 The combinations H of a few functions (the monomials of degree 1..d, sin and cos of each
 argument of a sin or cos in the field, log of each state positive on D, and log |x + c|
-where x + c divides x's own equation and keeps one sign on D) with dH/dt = 0 along x' = f(x) (H(f(x)) =
-H(x) for a map) form a linear space: written over the states and the field's atoms as
-indeterminates (ir/atoms.py), the conditions are linear equations in H's coefficients
-with rational entries, so the space is found exactly (python-flint's integer null
-space); a combination whose change is 0 over independent indeterminates is 0 for every
+where x + c divides x's own equation and keeps one sign on D) with dH/dt = 0 along
+x' = f(x) (H(f(x)) = H(x) for a map) form a linear space: written over the states and
+the field's atoms as indeterminates (ir/atoms.py), the conditions are linear equations
+in H's coefficients with rational entries, so the space is found exactly (python-flint's
+integer null space); a combination whose change is 0 over independent indeterminates is 0 for every
 value they take. An undamped pendulum's energy y^2 - 2 cos(x) is one.
 
 B = sum_k a_k H_k + c is then chosen by a linear program on samples (B <= -e on I,
@@ -128,6 +128,7 @@ def _invariant_logs(field, states, box) -> dict[E.Expr, E.Expr]:
     invariant (x + c is a Darboux polynomial), and the log of such factors is how the
     shifted Lotka-Volterra system conserves u - log(1 + u) + v - log(1 + v)."""
     import sympy
+    from sympy.polys.polyerrors import BasePolynomialError
     from fossil_dsl.ir.symbolic import from_sympy, to_sympy
     symbols = {s: sympy.Symbol(s) for s in states}
     logs = {}
@@ -135,7 +136,7 @@ def _invariant_logs(field, states, box) -> dict[E.Expr, E.Expr]:
         x = symbols[state]
         try:
             factors = sympy.factor_list(to_sympy(f, symbols), x)[1]
-        except sympy.PolynomialError:  # not a polynomial in x
+        except BasePolynomialError:  # not a polynomial in x
             continue
         for factor, _ in factors:
             c = _shift(factor, x)
