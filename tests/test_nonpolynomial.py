@@ -84,11 +84,10 @@ def test_damped_pendulum_certified_with_the_ball_proved_apart():
     recheck_from_text(result)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_upright_pendulum_never_certified(seed):
-    result = fossil_dsl.synthesise(spec_text(UPRIGHT), seed=seed, max_iters=3, learn_steps=300)
-    assert not result.certified
-    assert any(c.status == "sat" for c in result.conditions)
+def test_upright_pendulum_never_certified():
+    # refuted before any search: the linearisation at the upright has eigenvalue +1
+    result = fossil_dsl.synthesise(spec_text(UPRIGHT), seed=0, max_iters=3, learn_steps=300)
+    assert not result.certified and "the origin is unstable" in result.reason
 
 
 @pytest.mark.parametrize("layers", ["sigmoid(5), square(5)", "tanh(5), square(5)"])
