@@ -99,3 +99,16 @@ def test_no_true_stability_spec_is_refuted():
                                              "stable while avoid")
         assert refutation(plan) is None, path.name
     assert checked > 30
+
+
+def test_a_marginal_linearisation_is_named_where_a_run_is_not_certified():
+    from fossil_dsl.engine.unstable_origin import marginal_note
+    pendulum = ROOT / "specs/probe75/ay29_cubic_damped_pendulum_marginal_stable.fsl"
+    note = marginal_note(compile_spec(fossil_dsl.load(pendulum)))
+    assert "on the imaginary axis (0 + 1i, 0 - 1i)" in note
+    rotation = "    next(x) = 0.8*x - 0.6*y\n    next(y) = 0.6*x + 0.8*y"
+    assert "on the unit circle" in marginal_note(_plan(_system(rotation, time="discrete")))
+    damped = ROOT / "specs/probe75/ay06_atan_damped_pendulum_stable.fsl"
+    assert marginal_note(compile_spec(fossil_dsl.load(damped))) is None
+    result = fossil_dsl.synthesise(fossil_dsl.load(pendulum), max_iters=1, timeout=30)
+    assert not result.certified and "no quadratic V decreases strictly" in result.reason

@@ -7,7 +7,7 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
-from fossil_dsl.engine import torch_import
+from fossil_dsl.engine import torch_import, unstable_origin
 from fossil_dsl.engine.given import verifier_only
 from fossil_dsl.engine.loop import Cegis, CegisOutcome
 from fossil_dsl.plan.compile import Plan, richer_plan, variant_plan
@@ -36,7 +36,9 @@ def learn(plan: Plan, backend: Backend, listener, deadline: float,
         if other.certified:
             return richer, _after(outcome, other, note)
         note = "; ".join(n for n in (note, f"quartic templates: {other.reason}") if n)
-    return plan, replace(outcome, strategy="learning" + (f" ({note})" if note else ""))
+    marginal = None if outcome.certified else unstable_origin.marginal_note(plan)
+    return plan, replace(outcome, strategy="learning" + (f" ({note})" if note else ""),
+                         reason=outcome.reason + (f" ({marginal})" if marginal else ""))
 
 
 def learn_briefly(plan: Plan, backend: Backend, listener, deadline: float):

@@ -61,6 +61,32 @@ def refutation(plan: Plan) -> str | None:
     return None
 
 
+def marginal_note(plan: Plan) -> str | None:
+    """Where a stability-type run was not certified and the linearisation at the origin
+    has eigenvalues on the boundary (real part 0; modulus 1 for a map) and none beyond:
+    why quadratic functions cannot serve (they decrease only as fast as the linear part,
+    which is not at all along those eigenvalues), or None."""
+    spec, states = plan.spec, list(plan.states)
+    if spec.inputs or plan.certificate.form not in FORMS or \
+            not all(_smooth_at_origin(f, states) for f in spec.dynamics):
+        return None
+    jacobian = _jacobian_at_origin(spec.dynamics, states)
+    if jacobian is None:
+        return None
+    eigenvalues = np.linalg.eigvals(jacobian)
+    tolerance = MARGIN * max(1.0, float(np.abs(jacobian).max()))
+    discrete = spec.time is TimeDomain.DISCRETE
+    edge = np.abs(np.abs(eigenvalues) - 1) if discrete else np.abs(eigenvalues.real)
+    on_edge = [e for e, d in zip(eigenvalues, edge) if d <= tolerance]
+    if not on_edge:
+        return None
+    where = "on the unit circle" if discrete else "on the imaginary axis"
+    return (f"the linearisation at the origin has eigenvalues {where} "
+            f"({', '.join(_text(e) for e in on_edge)}): no quadratic V decreases strictly "
+            f"near the origin, and a V of higher degree must be proved there without the "
+            f"linear part's help")
+
+
 def refuted_outcome(plan: Plan, reason: str) -> CegisOutcome:
     """Not certified, for the reason given, with no function found (none was searched for)."""
     nothing = ExactCandidate({}, {}, {}, {}, plan.options.digits)
