@@ -37,17 +37,11 @@ NOT_SMOOTH_AT_ZERO = ("abs", "sqrt")  # not differentiable where their argument 
 def refutation(plan: Plan) -> str | None:
     """Why the property is false (the eigenvalue that makes the origin unstable), or None
     where this argument does not apply or decides nothing."""
-    spec, states = plan.spec, list(plan.states)
-    if spec.inputs or plan.certificate.form not in FORMS:
+    found = _linearisation(plan)
+    if found is None:
         return None
-    if not all(_smooth_at_origin(f, states) for f in spec.dynamics):
-        return None
-    jacobian = _jacobian_at_origin(spec.dynamics, states)
-    if jacobian is None:
-        return None
-    eigenvalues = np.linalg.eigvals(jacobian)
-    tolerance = MARGIN * max(1.0, float(np.abs(jacobian).max()))
-    if spec.time is TimeDomain.DISCRETE:
+    eigenvalues, tolerance = found
+    if plan.spec.time is TimeDomain.DISCRETE:
         worst = eigenvalues[np.argmax(np.abs(eigenvalues))]
         if abs(worst) > 1 + tolerance:
             return (f"the property is false: the origin is unstable (the map's "
@@ -66,16 +60,11 @@ def marginal_note(plan: Plan) -> str | None:
     has eigenvalues on the boundary (real part 0; modulus 1 for a map) and none beyond:
     why quadratic functions cannot serve (they decrease only as fast as the linear part,
     which is not at all along those eigenvalues), or None."""
-    spec, states = plan.spec, list(plan.states)
-    if spec.inputs or plan.certificate.form not in FORMS or \
-            not all(_smooth_at_origin(f, states) for f in spec.dynamics):
+    found = _linearisation(plan)
+    if found is None:
         return None
-    jacobian = _jacobian_at_origin(spec.dynamics, states)
-    if jacobian is None:
-        return None
-    eigenvalues = np.linalg.eigvals(jacobian)
-    tolerance = MARGIN * max(1.0, float(np.abs(jacobian).max()))
-    discrete = spec.time is TimeDomain.DISCRETE
+    eigenvalues, tolerance = found
+    discrete = plan.spec.time is TimeDomain.DISCRETE
     edge = np.abs(np.abs(eigenvalues) - 1) if discrete else np.abs(eigenvalues.real)
     on_edge = [e for e, d in zip(eigenvalues, edge) if d <= tolerance]
     if not on_edge:
@@ -85,6 +74,20 @@ def marginal_note(plan: Plan) -> str | None:
             f"({', '.join(_text(e) for e in on_edge)}): no quadratic V decreases strictly "
             f"near the origin, and a V of higher degree must be proved there without the "
             f"linear part's help")
+
+
+def _linearisation(plan: Plan):
+    """(the eigenvalues of the Jacobian at the origin, the tolerance that decides nothing
+    within it) for a stability-type property of a system without inputs whose field is
+    C^1 near the origin; else None."""
+    spec, states = plan.spec, list(plan.states)
+    if spec.inputs or plan.certificate.form not in FORMS or \
+            not all(_smooth_at_origin(f, states) for f in spec.dynamics):
+        return None
+    jacobian = _jacobian_at_origin(spec.dynamics, states)
+    if jacobian is None:
+        return None
+    return np.linalg.eigvals(jacobian), MARGIN * max(1.0, float(np.abs(jacobian).max()))
 
 
 def refuted_outcome(plan: Plan, reason: str) -> CegisOutcome:
