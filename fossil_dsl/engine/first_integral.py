@@ -6,8 +6,8 @@ where x + c divides x's own equation and keeps one sign on D) with dH/dt = 0 alo
 x' = f(x) (H(f(x)) = H(x) for a map) form a linear space: written over the states and
 the field's atoms as indeterminates (ir/atoms.py), the conditions are linear equations
 in H's coefficients with rational entries, so the space is found exactly (python-flint's
-integer null space); a combination whose change is 0 over independent indeterminates is 0 for every
-value they take. An undamped pendulum's energy y^2 - 2 cos(x) is one.
+integer null space); a combination whose change is 0 over independent indeterminates is
+0 for every value they take. An undamped pendulum's energy y^2 - 2 cos(x) is one.
 
 B = sum_k a_k H_k + c is then chosen by a linear program on samples (B <= -e on I,
 B >= e on U within D, largest e); a and c are rounded, and B stays exactly conserved
@@ -133,9 +133,9 @@ def _invariant_logs(field, states, box) -> dict[E.Expr, E.Expr]:
     symbols = {s: sympy.Symbol(s) for s in states}
     logs = {}
     for state, f, low, high in zip(states, field, *box):
-        x = symbols[state]
+        x, equation = symbols[state], to_sympy(f, symbols)
         try:
-            factors = sympy.factor_list(to_sympy(f, symbols), x)[1]
+            factors = sympy.factor_list(equation, x)[1]
         except BasePolynomialError:  # not a polynomial in x
             continue
         for factor, _ in factors:
@@ -143,7 +143,7 @@ def _invariant_logs(field, states, box) -> dict[E.Expr, E.Expr]:
             if c is not None and c != 0 and (low + c > 0 or high + c < 0):
                 sign = 1 if low + c > 0 else -1
                 log = E.apply("log", E.mul(E.Num(sign), E.add(E.Var(state), E.Num(c))))
-                quotient = sympy.cancel(to_sympy(f, symbols) / (x + sympy.Rational(c)))
+                quotient = sympy.cancel(equation / (x + sympy.Rational(c)))
                 logs[log] = from_sympy(quotient, states)
     return logs
 
@@ -157,7 +157,8 @@ def _shift(factor, x) -> Fraction | None:
     if poly.degree() != 1 or not all(k.is_Rational for k in poly.all_coeffs()):
         return None
     a, b = poly.all_coeffs()
-    return Fraction(int(sympy.numer(b / a)), int(sympy.denom(b / a)))
+    c = sympy.Rational(b / a)
+    return Fraction(int(c.p), int(c.q))
 
 
 def _passes(touching: list[str]):

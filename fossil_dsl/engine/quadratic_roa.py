@@ -9,8 +9,9 @@ The attempt is for `from I: stable` (no `region: largest`, which shapes V to the
 simulated basin) and `from I: stable and always not U`, with B = V - β where Ω misses U
 (Ω cannot be left, so {B <= 0} cannot either); for reach, RWA, RSWA and RAR, V = k (x^T P
 x - β) falling by 10 γ at the samples (RSWA's level just inside F; RAR's B a sublevel set
-just holding G, inside F, of the same quadratic or of its own: reach_shapes.py). A learner whose level is halfway between I and ∂D, or whose margin is large
-against a small V, misses such a pair (probe53/n01, an excitable neuron: the Lyapunov
+just holding G, inside F, of the same quadratic or of its own: reach_shapes.py). A
+learner whose level is halfway between I and ∂D, or whose margin is large against a
+small V, misses such a pair (probe53/n01, an excitable neuron: the Lyapunov
 equation's V holds at 1.05 times its largest value on I, fails at the halfway level).
 Nothing here is trusted: V and β are proved like any candidate.
 """

@@ -22,9 +22,9 @@ import numpy as np
 
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import traversal
-from fossil_dsl.ir.calculus import derivative
 from fossil_dsl.ir.enclosure import enclose
 from fossil_dsl.ir.spec import TimeDomain
+from fossil_dsl.engine.linear import jacobians
 from fossil_dsl.engine.loop import CegisOutcome, ExactCandidate
 from fossil_dsl.plan.certificates.roa import ROA_FORMS
 from fossil_dsl.plan.compile import Plan
@@ -84,9 +84,10 @@ def _linearisation(plan: Plan):
     if spec.inputs or plan.certificate.form not in FORMS or \
             not all(_smooth_at_origin(f, states) for f in spec.dynamics):
         return None
-    jacobian = _jacobian_at_origin(spec.dynamics, states)
-    if jacobian is None:
+    found = jacobians(spec)
+    if found is None:
         return None
+    jacobian = found[0]
     return np.linalg.eigvals(jacobian), MARGIN * max(1.0, float(np.abs(jacobian).max()))
 
 
@@ -118,22 +119,6 @@ def _smooth_at_origin(f: E.Expr, states) -> bool:
 def _natural(exponent: E.Expr) -> bool:
     return isinstance(exponent, E.Num) and exponent.value.denominator == 1 and \
         exponent.value >= 1
-
-
-def _jacobian_at_origin(field, states) -> np.ndarray | None:
-    """The Jacobian's entries at 0 (midpoints of enclosures no wider than MARGIN), or
-    None where one is not finite or not enclosed that tightly."""
-    origin = {s: E.ZERO for s in states}
-    rows = []
-    for f in field:
-        row = []
-        for s in states:
-            low, high = _enclosure(traversal.substitute(derivative(f, s), origin))
-            if not (math.isfinite(low) and math.isfinite(high)) or high - low > MARGIN:
-                return None
-            row.append((low + high) / 2)
-        rows.append(row)
-    return np.array(rows, dtype=float)
 
 
 def _enclosure(closed: E.Expr) -> tuple[float, float]:
