@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import fossil_dsl
-from fossil_dsl.engine import attempts, quadratic_roa
+from fossil_dsl.engine import quadratic_roa, region_attempts
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import logic as L
 from fossil_dsl.kernel import Claim, list_obligations
@@ -55,7 +55,7 @@ def quadrotor():
     spec = fossil_dsl.load(QUADROTOR)
     plan = compile_spec(spec)
     finding = next(quadratic_roa.candidates(plan, time.monotonic() + 30))
-    lemma = attempts._lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
+    lemma = region_attempts.lemma_plan(plan, finding.formulas, finding.controller, finding.levels)
     claim = Claim(spec, dict(finding.formulas), dict(finding.controller),
                   dict(finding.levels), lemma.origin_radius)
     decrease = next(o for o in list_obligations(claim) if o.name == "condition:decrease")

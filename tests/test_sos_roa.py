@@ -10,7 +10,7 @@ import pytest
 
 import fossil_dsl
 from fossil_dsl.engine import sos_roa
-from fossil_dsl.engine.attempts import _set_up
+from fossil_dsl.engine.proving import set_up
 from fossil_dsl.engine.loop import as_listener
 from fossil_dsl.engine.proving import prove_found
 from fossil_dsl.ir import expr as E
@@ -95,7 +95,7 @@ def test_the_found_v_is_refuted_for_the_closed_loop():
     found, note = prove_found(plan, registry.load(plan.verifier), as_listener(None),
                               time.monotonic() + 120, finding, 60.0, query_seconds=0.001,
                               formulas=finding.formulas,
-                              prepare=functools.partial(_set_up, finding=finding))
+                              prepare=functools.partial(set_up, finding=finding))
     assert found is not None, note  # the solvers had no time: the refutations did it
     assert found[1].refutations.keys() >= {"condition:decrease", "condition:boundary"}
 

@@ -7,6 +7,7 @@ import time
 from dataclasses import replace
 
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, IterationRecord, Verdict, failure_reason
+from fossil_dsl.engine.sos_reach import same_polynomial
 from fossil_dsl.kernel import Claim, list_obligations
 from fossil_dsl.kernel.prove import SUM_OF_SQUARES
 from fossil_dsl.plan.compile import Plan
@@ -31,6 +32,14 @@ STAND_IN_SHARE = 0.3
 # refutations leave: probe65/ao10's decrease, 10 slabs of its pitch at 5-7 s each
 SLAB_SECONDS = 80.0
 SLAB_SHARE = 0.5  # of the run's time left, at most (learning may still do it)
+SOS_SHARE = 0.25  # of the run's time, at most, for a sum-of-squares attempt's program
+SOS_SECONDS = 30.0  # and never more than this
+# the reach attempt's refutations get twice what its program took, and at least this:
+# a refutation program is about as large as the program (a 5-state map's degree-6
+# decrease, probe49/e08: V found in 16 s, its decrease refuted in 12-18 s), and a small
+# floor keeps hopeless ones short (g04: its quartic V's refutations took 40 s and failed;
+# a quadratic V's are found in well under a second)
+REACH_REFUTING_SECONDS = 5.0
 
 
 def budgets(finding, floor: float, deadline: float) -> tuple[float, float]:
@@ -166,3 +175,23 @@ def _how(refutation) -> str:
     if isinstance(refutation, SlabSplit):
         return f"refuted in {len(refutation.slabs)} slabs across {refutation.variable}"
     return ""
+
+
+def set_up(cegis: Cegis, finding) -> None:
+    """The controller and the levels (RSWA's β) the functions were found for."""
+    if finding.controller:
+        controller_set(cegis, finding)
+    cegis.learner.fixed_levels = dict(finding.levels)
+
+
+def controller_set(cegis: Cegis, finding) -> None:
+    """Sets the loop's controller network to the gain the functions were found for;
+    raises NotSetUp unless its exact formulas are the ones the program used."""
+    from fossil_dsl.engine.linear import set_linear
+    controller = cegis.learner.controller
+    set_linear(controller, finding.gain, finding.operating)
+    exact = controller.formulas(cegis.states, cegis.learner.digits)
+    states = cegis.states
+    if not all(same_polynomial(formula, finding.controller[u], states)
+               for u, formula in zip(cegis.plan.controller.inputs, exact)):
+        raise NotSetUp("the controller network cannot hold its gain")

@@ -48,7 +48,7 @@ def applies(plan: Plan) -> bool:
 
 def attempt(plan: Plan, backend, listener, deadline: float, prove):
     """((plan with V and B given, β fixed, certified outcome) or None, what happened);
-    `prove` is attempts.py's proof of a region's finding (with the Taylor lemma's ball,
+    `prove` is region_attempts.py's proof of a region's finding (with the Taylor lemma's ball,
     else the plan's own), given the refutations' and queries' seconds."""
     listener.phase(0, "V and B found apart")
     budget = time.monotonic() + min(SECONDS, SHARE * plan.options.timeout)
