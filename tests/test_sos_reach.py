@@ -189,6 +189,23 @@ def test_a_rational_field_is_multiplied_through_by_its_positive_denominator():
     assert result.strategy.startswith("sum-of-squares programming"), result.strategy
 
 
+def test_a_rational_reach_avoid_remain_gets_b_multiplied_through_too():
+    """probe76/az14 (Michaelis-Menten uptake, a feed as input): the barrier program of
+    RAR was only for polynomial fields, and the run timed out learning; B's decay,
+    grad B . N <= -mu B Q, is as linear in B as the polynomial one."""
+    text = (ROOT / "specs/probe76/az14_michaelis_menten_rar_ctrl.fsl").read_text()
+    plan = compile_spec(fossil_dsl.loads(text), seed=0)
+    finding = sos_reach.search(plan, time.monotonic() + 30)
+    assert finding is not None and finding.degree and finding.barrier_degree
+    assert not finding.stand_in  # the exact rational field, no stand-in
+    result = fossil_dsl.synthesise(fossil_dsl.loads(text), timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+    B = result.sympy["B"]
+    p, s = sorted(B.free_symbols, key=str)
+    assert float(B.subs({s: 0, p: 0})) <= 0 < float(B.subs({s: 0.5, p: 0}))  # F: 0.1
+
+
 def test_a_denominator_that_changes_sign_on_the_domain_gives_no_program():
     x, y = E.Var("x0"), E.Var("x1")
     box = ((-2, -2), (2, 2))

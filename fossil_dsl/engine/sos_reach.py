@@ -1,7 +1,7 @@
 """A sum-of-squares attempt for reach-type properties (reach, RWA, RSWA, RAR) of a
-polynomial ODE (or, for reach and RWA, a rational one f = N / Q with Q > 0 on D, where
-the decrease is asked of grad V . N + γ Q, multiplied through by Q: rational_field.py;
-of any other ODE through a polynomial stand-in for its field: surrogate.py), and for
+polynomial ODE (or a rational one f = N / Q with Q > 0 on D, where the decrease is
+asked of grad V . N + γ Q, multiplied through by Q, RAR's B's decay likewise:
+rational_field.py; of any other ODE through a polynomial stand-in for its field: surrogate.py), and for
 every reach-type property of a map (polynomial, or through a stand-in; the decrease is
 V(f(x)) - V(x), still linear in V's coefficients; the kernel's further conditions that a
 step from S outside G with V <= 0 lands in S, and for RSWA from F with V <= β in F, are
@@ -151,7 +151,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
         if time.monotonic() > deadline or stand_in and index >= STAND_IN_CONTROLLERS:
             break
         b = None if pieces.outside_final is None else \
-            _barrier(len(states), field, pieces, deadline, discrete)
+            _barrier(len(states), field, pieces, deadline, discrete, denominator)
         if pieces.outside_final is not None and b is None:
             continue
         loops.append(_Loop(controller, gain, field, denominator, stand_in, b))
@@ -194,16 +194,16 @@ def _finding(plan: Plan, found, loop: _Loop, centre, operating, started: float) 
 
 def _over_denominator(closed, plan: Plan, pieces: Pieces, discrete: bool):
     """(N, Q, the stand-in's degree) for a system that is not polynomial: an ODE's
-    rational field over one denominator Q > 0 (the programs are multiplied through by Q;
-    RAR's barrier program is for polynomial fields), else a polynomial stand-in over
-    Q = 1, of lower degree for a map (V(p(x)) multiplies the degrees); or None."""
+    rational field over one denominator Q > 0 (the programs, RAR's barrier program too,
+    are multiplied through by Q), else a polynomial stand-in over Q = 1, of lower degree
+    for a map (V(p(x)) multiplies the degrees); or None."""
     if discrete:
         return _stand_in(closed, plan, MAP_STAND_IN_DEGREES)
     if all(traversal.is_arithmetic(f) for f in closed):
         found = over_one_denominator(closed, plan.states, plan.spec.domain.bounding_box(),
                                      plan.options.seed)
         if found is not None:
-            return None if pieces.outside_final is not None else (*found, 0)
+            return (*found, 0)
     return _stand_in(closed, plan, STAND_IN_DEGREES)
 
 
@@ -263,9 +263,10 @@ def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int, Pieces]]:
     return shapes
 
 
-def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool):
+def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool,
+             denominator: P.Polynomial | None = None):
     """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B (for a map B(f(x)) - B(x)
-    <= -mu B) on D, of degree 2, then 4 (a hardening spring's x^3 outgrows every
+    <= -mu B; for a field N / Q, grad B . N <= -mu B Q) on D, of degree 2, then 4 (a hardening spring's x^3 outgrows every
     quadratic's decay on D: probe54/o07); else the decay on F only, where B > 0 on D
     outside F puts {B <= 0} (probe61/af13: states at D's corner leave D, and no B decays
     on all of it), after D: the kernel's queries know D, not F, and B's step conditions
@@ -277,7 +278,7 @@ def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool):
         if time.monotonic() > deadline:
             return None
         program = BarrierProgram(n, field, [pieces.goal], pieces.outside_final, region,
-                                 half, mu, discrete=discrete)
+                                 half, mu, denominator, discrete=discrete)
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
             return program.exact_b(x)
