@@ -298,6 +298,21 @@ def test_a_map_reach_and_stay_is_certified_by_the_program():
     assert float(step.subs({x0: 0, x1: 0})) < beta
 
 
+def test_reach_and_stay_lets_v_be_steep_enough_to_fall_by_gamma_near_f():
+    """probe73/aw29 (a sampled unstable plant with one input): RSWA asks V's decrease
+    down to a ball of a quarter of F's reach, so a V that holds I far out needs large
+    coefficients there; within the reach programs' bound of 100 no V of degree up to 8
+    was found, and learning timed out. With STAY_BOUND a quartic V is."""
+    spec = fossil_dsl.load(ROOT / "specs/probe73/aw29_sampled_settle_ctrl_map.fsl")
+    finding = sos_reach.search(compile_spec(spec, seed=0), time.monotonic() + 30)
+    assert finding is not None and finding.degree == 4 and "beta" in finding.levels
+    V = P.polynomial(finding.formulas["V"], list(spec.states))
+    assert max(abs(c) for c in V.values()) > sos_reach.BOUND  # steeper than elsewhere
+    result = fossil_dsl.synthesise(spec, seed=0, timeout=120)
+    assert result.certified and result.kernel.certified, result.summary()
+    assert result.strategy.startswith("sum-of-squares programming"), result.strategy
+
+
 def test_the_program_finds_nothing_for_a_false_reach_and_stay_property_of_a_map():
     """f49: a tanh map's orbits from I overshoot into U before settling in F."""
     _finds_nothing("f49_tanh_map_rswa_overshoot")

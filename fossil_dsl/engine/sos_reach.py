@@ -1,14 +1,16 @@
 """A sum-of-squares attempt for reach-type properties (reach, RWA, RSWA, RAR) of a
-polynomial ODE (or a rational one f = N / Q with Q > 0 on D, where the decrease is
-asked of grad V . N + γ Q, multiplied through by Q, RAR's B's decay likewise:
-rational_field.py; of any other ODE through a polynomial stand-in for its field: surrogate.py), and for
-every reach-type property of a map (polynomial, or through a stand-in; the decrease is
-V(f(x)) - V(x), still linear in V's coefficients; the kernel's further conditions that a
-step from S outside G with V <= 0 lands in S, and for RSWA from F with V <= β in F, are
-left to the proof); where the system has inputs, with a linear controller
-fixed beforehand to an LQR gain of its linearisation, rounded as the verifier will see it.
+polynomial ODE (or a rational one f = N / Q with Q > 0 on D, where the decrease is asked
+of grad V . N + γ Q, multiplied through by Q, RAR's B's decay likewise:
+rational_field.py; of any other ODE through a polynomial stand-in for its field:
+surrogate.py), and for every reach-type property of a map (polynomial, or through a
+stand-in; the decrease is V(f(x)) - V(x), still linear in V's coefficients; the kernel's
+further conditions that a step from S outside G with V <= 0 lands in S, and for RSWA
+from F with V <= β in F, are left to the proof); where the system has inputs, with a
+linear controller fixed beforehand to an LQR gain of its linearisation, rounded as the
+verifier will see it.
 
-V (a polynomial of degree 2 or 4, coefficients in [-100, 100]) and the largest e with
+V (a polynomial of degree 2 or 4, coefficients in [-100, 100], for RSWA in [-10^4, 10^4])
+and the largest e with
 
     -V - e                >= 0  on each member of I (a union's, each)
      V - e                >= 0  on each face of D, and on D outside the interior of S
@@ -67,6 +69,12 @@ MIN_MARGIN = 1e-6
 # |coefficient| of V at most this: γ is absolute, so V must be free to be steep (a
 # quadratic that holds I far out and decreases by γ at G's edge needs entries above 1)
 BOUND = 100.0
+# and for RSWA, whose decrease is asked down to a ball of a quarter of F's reach: V
+# holding I far out must fall by γ there too (probe73/aw29, a sampled unstable plant: no
+# V of degree 8 within 100, a quartic within 10 000 with margin 0.29); and the margin
+# grows with the bound, which a V solved for a stand-in needs (probe75/ay33: margin
+# 0.017 within 100, its decrease refuted for the true map; margin 1 within 10 000)
+STAY_BOUND = 10_000.0
 
 
 @dataclass(frozen=True)
@@ -161,7 +169,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
             return _finding(plan, found, loops[-1], centre, operating, started)
     # then, for the first closed loop, {V <= 0} in a box round I and G: after every
     # loop's own programs (probe59/ac15's second gain: found 10 s later behind them)
-    confining = [(0.0, half, pieces.confined(box)) for box in confining_boxes(plan)
+    confining = [(0.0, half, pieces.confined(box), BOUND) for box in confining_boxes(plan)
                  for half in HALF_DEGREES]
     if loops and confining and pieces.stay is None:
         first = loops[0]
@@ -234,10 +242,10 @@ def _functions(n: int, field, denominator, b, shapes, pieces: Pieces, deadline: 
     `partial` (no controller), RAR's B alone when no V is found (degree 0): V's program
     asks for a decrease on all of D outside G, which a basin smaller than D rules out;
     and V's programs with a growth rate are tried too."""
-    for rate, half, asked in shapes:
+    for rate, half, asked, bound in shapes:
         if time.monotonic() > deadline:
             return None
-        program = _ReachProgram(n, field, denominator, asked, half, discrete, rate)
+        program = _ReachProgram(n, field, denominator, asked, half, discrete, rate, bound)
         if program.count > MAX_VARIABLES:
             continue
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
@@ -250,15 +258,18 @@ def _functions(n: int, field, denominator, b, shapes, pieces: Pieces, deadline: 
     return ({"B": b}, {}, 0, 0.0, False) if partial and b is not None else None
 
 
-def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int, Pieces]]:
-    """(λ, half-degree, pieces) of V's programs in turn: decrease on all of D outside G,
-    then (`growing`; not for RSWA, whose decrease pieces are its own) only where V <= 0.
-    With a controller (an LQR gain: one equilibrium in D) the latter served no spec of
+def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int, Pieces, float]]:
+    """(λ, half-degree, pieces, V's coefficient bound) of V's programs in turn: decrease
+    on all of D outside G, then (`growing`; not for RSWA, whose decrease pieces are its
+    own) only where V <= 0; for RSWA, the first ones with STAY_BOUND. With a
+    controller (an LQR gain: one equilibrium in D) the growing ones served no spec of
     session 70's reach bench and cost up to 30 s of programs and failed proofs
     (probe65/an14: certified in 45 s -> timeout)."""
-    shapes = [(0.0, half, pieces) for half in HALF_DEGREES]
-    if growing and pieces.stay is None:
-        shapes += [(rate, half, pieces) for half in GROWING_HALF_DEGREES
+    if pieces.stay is not None:
+        return [(0.0, half, pieces, STAY_BOUND) for half in HALF_DEGREES]
+    shapes = [(0.0, half, pieces, BOUND) for half in HALF_DEGREES]
+    if growing:
+        shapes += [(rate, half, pieces, BOUND) for half in GROWING_HALF_DEGREES
                    for rate in GROWTH_RATES]
     return shapes
 
@@ -266,12 +277,12 @@ def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int, Pieces]]:
 def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool,
              denominator: P.Polynomial | None = None):
     """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B (for a map B(f(x)) - B(x)
-    <= -mu B; for a field N / Q, grad B . N <= -mu B Q) on D, of degree 2, then 4 (a hardening spring's x^3 outgrows every
-    quadratic's decay on D: probe54/o07); else the decay on F only, where B > 0 on D
-    outside F puts {B <= 0} (probe61/af13: states at D's corner leave D, and no B decays
-    on all of it), after D: the kernel's queries know D, not F, and B's step conditions
-    for probe71/au24 took 10 s of interval proof instead of 0.3 s of refutations; or
-    None."""
+    <= -mu B; for a field N / Q, grad B . N <= -mu B Q) on D, of degree 2, then 4 (a
+    hardening spring's x^3 outgrows every quadratic's decay on D: probe54/o07); else the
+    decay on F only, where B > 0 on D outside F puts {B <= 0} (probe61/af13: states at
+    D's corner leave D, and no B decays on all of it), after D: the kernel's queries know
+    D, not F, and B's step conditions for probe71/au24 took 10 s of interval proof
+    instead of 0.3 s of refutations; or None."""
     rates = MAP_DECAY_RATES if discrete else DECAY_RATES
     for region, half, mu in itertools.product((pieces.domain, pieces.final), HALF_DEGREES,
                                               rates):
@@ -287,10 +298,10 @@ def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool,
 
 class _ReachProgram(Program):
     def __init__(self, n: int, field, denominator, pieces: Pieces, half: int,
-                 discrete: bool, rate: float = 0.0):
+                 discrete: bool, rate: float = 0.0, bound: float = BOUND):
         super().__init__(n, searches=True)
         self.basis = P.monomials(n, 0, 2 * half)
-        self.coefficients = self.unknown_polynomial(self.basis, BOUND)
+        self.coefficients = self.unknown_polynomial(self.basis, bound)
         self.margin = self.scalar()
         self.at_most.append(({self.margin: 1.0}, 1.0))
         terms = [{m: Fraction(1)} for m in self.basis]
@@ -311,7 +322,7 @@ class _ReachProgram(Program):
         self.beta = None
         if stay is not None:  # V - β > 0 on F outside the outer ball, < 0 on the inner
             self.beta = self.scalar()
-            self.at_most += [({self.beta: 1.0}, BOUND), ({self.beta: -1.0}, BOUND)]
+            self.at_most += [({self.beta: 1.0}, bound), ({self.beta: -1.0}, bound)]
             one = P.constant(1, n)
             above = list(zip(self.coefficients, terms)) + [(self.beta, P.scale(one, -1))]
             for piece in stay.above:
