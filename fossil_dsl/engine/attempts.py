@@ -20,11 +20,11 @@ from fossil_dsl.engine.learning import learn, learn_briefly, learning_imported
 from fossil_dsl.engine.loop import Cegis, CegisOutcome, as_listener
 from fossil_dsl.engine.proving import (REACH_REFUTING_SECONDS, SOS_QUERY_SECONDS, SOS_SECONDS,
                                        SOS_SHARE, NotSetUp, budgets, controller_set,
-                                       only_function, prove_found, set_up, verify_given)
+                                       only_function, program_finding, prove_found, set_up,
+                                       verify_given)
 from fossil_dsl.engine.region_attempts import (BASIN_QUERY_SECONDS, lemma_ball,
-                                               program_finding, quadratic_region,
-                                               region_proved, region_sum_of_squares,
-                                               shaped_to_basin)
+                                               quadratic_region, region_proved,
+                                               region_sum_of_squares, shaped_to_basin)
 from fossil_dsl.engine.sos_barrier import barrier
 from fossil_dsl.plan.compile import Plan, variant_plan
 from fossil_dsl.solvers.api import Backend

@@ -177,6 +177,12 @@ def _how(refutation) -> str:
     return ""
 
 
+def program_finding(plan: Plan, listener, phase: str, search):
+    """What a program's search finds within the sum-of-squares budget (or None)."""
+    listener.phase(0, phase)
+    return search(plan, time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout))
+
+
 def set_up(cegis: Cegis, finding) -> None:
     """The controller and the levels (RSWA's β) the functions were found for."""
     if finding.controller:

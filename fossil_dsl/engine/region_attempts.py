@@ -14,8 +14,8 @@ import numpy as np
 from fossil_dsl.engine import basin, quadratic_roa, sos_roa
 from fossil_dsl.engine.lemma_radius import lemma_radius
 from fossil_dsl.engine.proving import (REACH_REFUTING_SECONDS, SOS_QUERY_SECONDS, SOS_SECONDS,
-                                       SOS_SHARE, budgets, only_function, prove_found,
-                                       set_up, verify_given)
+                                       SOS_SHARE, budgets, only_function, program_finding,
+                                       prove_found, set_up, verify_given)
 from fossil_dsl.ir import traversal
 from fossil_dsl.kernel import Claim
 from fossil_dsl.plan.compile import Plan, origin_radius, variant_plan
@@ -170,9 +170,3 @@ def lemma_ball(plan: Plan, finding) -> Plan | None:
                   origin_radius(plan.spec))
     radius = lemma_radius(claim)
     return None if radius is None else replace(plan, origin_radius=radius)
-
-
-def program_finding(plan: Plan, listener, phase: str, search):
-    """What a program's search finds within the sum-of-squares budget (or None)."""
-    listener.phase(0, phase)
-    return search(plan, time.monotonic() + min(SOS_SECONDS, SOS_SHARE * plan.options.timeout))

@@ -152,7 +152,7 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
         field = _polynomial(closed, states)
         denominator, stand_in = P.constant(1, len(states)), 0
         if field is None:
-            found = _over_denominator(closed, plan, pieces, discrete)
+            found = _over_denominator(closed, plan, discrete)
             if found is None:
                 continue
             field, denominator, stand_in = found
@@ -200,7 +200,7 @@ def _finding(plan: Plan, found, loop: _Loop, centre, operating, started: float) 
                         confined)
 
 
-def _over_denominator(closed, plan: Plan, pieces: Pieces, discrete: bool):
+def _over_denominator(closed, plan: Plan, discrete: bool):
     """(N, Q, the stand-in's degree) for a system that is not polynomial: an ODE's
     rational field over one denominator Q > 0 (the programs, RAR's barrier program too,
     are multiplied through by Q), else a polynomial stand-in over Q = 1, of lower degree
