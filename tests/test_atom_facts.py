@@ -72,7 +72,8 @@ def test_every_fact_holds_at_every_point_of_its_range(func, ends, share):
 
 
 @settings(max_examples=300, deadline=None)
-@given(func=st.sampled_from(("sin", "cos")), low=st.fractions(-7, 7, max_denominator=1000),
+@given(func=st.sampled_from(("sin", "cos", "tanh")),
+       low=st.fractions(-7, 7, max_denominator=1000),
        width=st.fractions(F(1, 10 ** 6), F(1, 2), max_denominator=10 ** 6),
        share=st.fractions(0, 1, max_denominator=1000))
 def test_taylor_facts_hold_on_every_narrow_range(func, low, width, share):
@@ -87,13 +88,14 @@ def test_taylor_facts_hold_on_every_narrow_range(func, low, width, share):
             assert _not_refuted(fact, env), (func, low, high, a, L.formula_text(fact))
 
 
-def test_taylor_facts_are_tight_and_fail_off_the_function():
-    facts, atom = _facts("sin", F(2, 5), F(1, 2))
+@pytest.mark.parametrize("func", ["sin", "tanh"])
+def test_taylor_facts_are_tight_and_fail_off_the_function(func):
+    facts, atom = _facts(func, F(2, 5), F(1, 2))
     upper, lower = facts[-2:]  # (after t^2 <= 1)
-    # the band the facts leave sin a on [0.4, 0.5] is below 4e-4 wide, so a value 1e-3
-    # off the true sine at the middle is refuted by one of them
+    # the band the facts leave sin a (tanh a) on [0.4, 0.5] is below 4e-4 (7e-4) wide,
+    # so a value 1e-3 off the true value at the middle is refuted by one of them
     for offset in (F(1, 1000), F(-1, 1000)):
-        env = _at(F(9, 20), "sin", atom)
+        env = _at(F(9, 20), func, atom)
         env[atom] = env[atom] + sympy.Rational(offset.numerator, offset.denominator)
         assert not (_not_refuted(upper, env) and _not_refuted(lower, env))
 

@@ -414,11 +414,11 @@ def test_fallback_goes_to_the_second_solver_first_for_a_form_it_decided():
 
 def test_interval_compiler_shares_equal_subexpressions():
     from fossil_dsl.ir.enclosure import upward_rounding
-    from fossil_dsl.solvers.interval_backend import _Compiler
+    from fossil_dsl.solvers.codac_compiler import Compiler
     x, y = E.Var("x0"), E.Var("x1")
     neuron = lambda: E.apply("tanh", E.add(E.mul(E.Num(2), x), y))
     with upward_rounding() as codac:
-        compiler = _Compiler(codac, ["x0", "x1"])
+        compiler = Compiler(codac, ["x0", "x1"])
         assert compiler.expr(neuron()) is compiler.expr(neuron())
         assert compiler.expr(E.mul(neuron(), x)) is not compiler.expr(neuron())
 

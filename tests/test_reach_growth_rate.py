@@ -10,7 +10,9 @@ import numpy as np
 import fossil_dsl
 from fossil_dsl.engine import sos_reach
 from fossil_dsl.engine.evaluate import evaluate, state_env
+from fossil_dsl.engine.polynomial_field import PolynomialField
 from fossil_dsl.engine.reach_pieces import Pieces
+from fossil_dsl.engine.reach_program import ReachProgram
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.plan.compile import compile_spec
 
@@ -19,9 +21,9 @@ SPIKE = SPECS / "probe68/ar15_fitzhugh_nagumo_spike_reach.fsl"
 
 
 def _feasible(plan, rate: float, half: int) -> bool:
-    field = [P.polynomial(f, plan.states) for f in plan.spec.dynamics]
-    program = sos_reach._ReachProgram(len(plan.states), field, P.constant(1, 2),
-                                      Pieces(plan), half, False, rate)
+    field = PolynomialField(2, [P.polynomial(f, plan.states) for f in plan.spec.dynamics],
+                            P.constant(1, 2), [])
+    program = ReachProgram(len(plan.states), field, Pieces(plan), half, False, rate)
     x = program.solve({program.margin: -1.0}, 60)
     return x is not None and x[program.margin] > sos_reach.MIN_MARGIN
 

@@ -226,12 +226,22 @@ def test_recheck_takes_another_procedure_than_the_taylor_forms():
 
 
 def test_the_interval_verifier_names_the_taylor_forms_when_they_decide():
+    # from 4 variables the Taylor forms go first (on 3, codac has a first slice)
     from fossil_dsl.solvers.interval_backend import IntervalBackend
-    query = L.conjunction(*_box("xyz", Fraction(1, 2), 1), L.Compare(
-        ">=", E.apply("sin", E.mul(X, Y, E.Var("z"))), E.mul(X, Y, E.Var("z"))))
-    assert IntervalBackend().check(query, ["x", "y", "z"], 10).solver == "taylor"
-    alone = IntervalBackend(taylor=False).check(query, ["x", "y", "z"], 10)
-    assert alone.status is Status.UNSAT and alone.solver != "taylor"
+    product = E.mul(X, Y, E.Var("z"), E.Var("w"))
+    query = L.conjunction(*_box("xyzw", Fraction(1, 2), 1),
+                          L.Compare(">=", E.apply("sin", product), product))
+    answer = IntervalBackend().check(query, list("xyzw"), 10)
+    assert answer.status is Status.UNSAT and answer.solver == "taylor"
+
+
+def test_codac_settles_a_small_3_variable_query_before_the_taylor_forms():
+    # x y z >= 2 on [1/2, 1]^3: codac's first contraction empties the box
+    from fossil_dsl.solvers.interval_backend import IntervalBackend
+    query = L.conjunction(*_box("xyz", Fraction(1, 2), 1),
+                          L.Compare(">=", E.mul(X, Y, E.Var("z")), E.Num(Fraction(2))))
+    answer = IntervalBackend().check(query, ["x", "y", "z"], 10)
+    assert answer.status is Status.UNSAT and answer.solver != "taylor"
 
 
 def test_a_side_without_variables_is_read_on_every_box():

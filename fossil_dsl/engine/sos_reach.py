@@ -33,26 +33,24 @@ from __future__ import annotations
 import itertools
 import time
 from dataclasses import dataclass
-from fractions import Fraction
 from typing import NamedTuple
 
 import numpy as np
 
 from fossil_dsl.engine.linear import operating_point
+from fossil_dsl.engine.polynomial_field import PolynomialField, celled_field, exact_field
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers, set_point_bias
 from fossil_dsl.engine.rational_field import over_one_denominator
 from fossil_dsl.engine.reach_pieces import Pieces, confining_boxes, set_point
-from fossil_dsl.engine.sos import Inexact, rounded
+from fossil_dsl.engine.reach_program import BOUND, ReachProgram
+from fossil_dsl.engine.sos import Inexact
 from fossil_dsl.engine.sos_barrier import DECAY_RATES, MAP_DECAY_RATES, BarrierProgram
 from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import expr as E
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal
 from fossil_dsl.ir.spec import TimeDomain
-from fossil_dsl.plan.certificates.rwa import GAMMA
 from fossil_dsl.plan.compile import Plan, default_synthesis
-from fossil_dsl.solvers.sdp import Program
-from fossil_dsl.solvers.gram_rounding import decimal
 from fossil_dsl.solvers.sos_refutation import MAX_VARIABLES
 
 FORMS = ("reach while avoid", "reach", "reach-avoid-remain", "reach and stay while avoid")
@@ -64,12 +62,13 @@ GROWING_HALF_DEGREES = (1, 2, 3)  # ar15: degree 6 (margin 1 at λ = 1; none of 
 STAND_IN_DEGREES, MAP_STAND_IN_DEGREES = (3, 5, 7), (3, 5)
 # LQR gains tried with a stand-in, at most: where it works the first or second gain did
 STAND_IN_CONTROLLERS = 3  # (19 specs with inputs; probe36/r01's eight programs took 8.5 s)
-DECIMALS = 6  # kept of V's coefficients
 MIN_MARGIN = 1e-6
-# |coefficient| of V at most this: γ is absolute, so V must be free to be steep (a
-# quadratic that holds I far out and decreases by γ at G's edge needs entries above 1)
-BOUND = 100.0
-# and for RSWA, whose decrease is asked down to a ball of a quarter of F's reach: V
+# a program with D's facts for the functions, at most this size: they are tried before
+# the stand-in, and an exp map's infeasible quartic ones (4 321 variables, 3-4 s each)
+# cost 10 s before the stand-in's V (probe62/ah11: 0.2 -> 12.9 s); the largest that found
+# a V in the repo's map reach specs had 2 887 (probe76/az24)
+FACTS_MAX_VARIABLES = 3_000
+# |coefficient| of V at most BOUND (reach_program.py), and for RSWA, whose decrease is asked down to a ball of a quarter of F's reach: V
 # holding I far out must fall by γ there too (probe73/aw29, a sampled unstable plant: no
 # V of degree 8 within 100, a quartic within 10 000 with margin 0.29); and the margin
 # grows with the bound, which a V solved for a stand-in needs (probe75/ay33: margin
@@ -93,6 +92,7 @@ class ReachFinding:
     barrier_degree: int = 0  # RAR's B (0: none)
     stand_in: int = 0  # the degree of the field's polynomial stand-in (0: none)
     confined: bool = False  # V > 0 outside a box round I and G (Pieces.confined)
+    cells: int = 0  # cells of D with their own facts (polynomial_field.celled_field)
 
     def describe(self) -> str:
         if not self.degree:
@@ -111,6 +111,8 @@ class ReachFinding:
                 f"{self.seconds:.2f} s")
 
     def _stand_in(self) -> str:
+        if self.cells:
+            return f" (the functions' facts on each of {self.cells} cells of D)"
         return (f" (solved for a polynomial stand-in of degree {self.stand_in} for the "
                 "field)") if self.stand_in else ""
 
@@ -147,23 +149,14 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
     rng = np.random.default_rng(plan.options.seed)
     discrete = spec.time is TimeDomain.DISCRETE
     loops = []
-    for index, (controller, gain) in enumerate(lqr_controllers(plan, operating, rng, centre)):
-        closed = [traversal.substitute(f, controller) for f in spec.dynamics]
-        field = _polynomial(closed, states)
-        denominator, stand_in = P.constant(1, len(states)), 0
-        if field is None:
-            found = _over_denominator(closed, plan, discrete)
-            if found is None:
-                continue
-            field, denominator, stand_in = found
-        if time.monotonic() > deadline or stand_in and index >= STAND_IN_CONTROLLERS:
-            break
+    for controller, gain, field, stand_in in _closed_loops(plan, operating, rng, centre,
+                                                           discrete, deadline):
         b = None if pieces.outside_final is None else \
-            _barrier(len(states), field, pieces, deadline, discrete, denominator)
+            _barrier(len(states), field, pieces, deadline, discrete)
         if pieces.outside_final is not None and b is None:
             continue
-        loops.append(_Loop(controller, gain, field, denominator, stand_in, b))
-        found = _functions(len(states), field, denominator, b, _shapes(pieces, not controller),
+        loops.append(_Loop(controller, gain, field, stand_in, b))
+        found = _functions(len(states), field, b, _shapes(pieces, not controller),
                            pieces, deadline, discrete, partial=not controller)
         if found is not None:
             return _finding(plan, found, loops[-1], centre, operating, started)
@@ -173,19 +166,53 @@ def search(plan: Plan, deadline: float) -> ReachFinding | None:
                  for half in HALF_DEGREES]
     if loops and confining and pieces.stay is None:
         first = loops[0]
-        found = _functions(len(states), first.field, first.denominator, first.barrier,
-                           confining, pieces, deadline, discrete)
+        found = _functions(len(states), first.field, first.barrier, confining, pieces,
+                           deadline, discrete)
         if found is not None:
             return _finding(plan, found, loops[0], centre, operating, started)
     return None
 
 
+def _closed_loops(plan: Plan, operating, rng, centre, discrete: bool, deadline: float):
+    """(controller, gain, the closed loop in polynomial form, its stand-in's degree) for
+    each LQR gain in turn (one without inputs), each of its forms (_fields); an inexact
+    or abstracted form for the first STAND_IN_CONTROLLERS gains only."""
+    for index, (controller, gain) in enumerate(lqr_controllers(plan, operating, rng, centre)):
+        closed = [traversal.substitute(f, controller) for f in plan.spec.dynamics]
+        for field, stand_in in _fields(closed, plan, discrete):
+            if time.monotonic() > deadline or \
+                    (stand_in or field.facts) and index >= STAND_IN_CONTROLLERS:
+                return
+            yield controller, gain, field, stand_in
+
+
+def _fields(closed, plan: Plan, discrete: bool):
+    """(the closed loop in polynomial form, its stand-in's degree): polynomial, else for
+    a map with functions (not RAR, whose B program has no facts for maps) with a variable
+    per application bounded by its facts on D (exact), then over a denominator or as a
+    stand-in, then the exact form with the facts on each cell of a grid on D (probe77/
+    ba11's tanh network: no stand-in within 1 % on D, no V with D's facts)."""
+    n = len(plan.states)
+    field = _polynomial(closed, plan.states)
+    if field is not None:
+        yield PolynomialField(n, field, P.constant(1, n), []), 0
+        return
+    exact = discrete and plan.certificate.form != "reach-avoid-remain"
+    if exact and (whole := exact_field(plan, closed)) and whole.facts \
+            and not P.degree(whole.denominator):
+        yield whole, 0
+    found = _over_denominator(closed, plan, discrete)
+    if found is not None:
+        yield PolynomialField(n, found[0], found[1], []), found[2]
+    if exact and (celled := celled_field(plan, closed)) and not P.degree(celled.denominator):
+        yield celled, 0
+
+
 class _Loop(NamedTuple):
-    """A closed loop tried: the controller, its field over a denominator, RAR's B."""
+    """A closed loop tried: the controller, its field in polynomial form, RAR's B."""
     controller: dict
     gain: np.ndarray | None
-    field: list
-    denominator: P.Polynomial
+    field: PolynomialField
     stand_in: int
     barrier: P.Polynomial | None
 
@@ -197,7 +224,7 @@ def _finding(plan: Plan, found, loop: _Loop, centre, operating, started: float) 
                         set_point_bias(operating, loop.gain, centre), degree, margin,
                         time.monotonic() - started, levels,
                         P.degree(formulas["B"]) if "B" in formulas else 0, loop.stand_in,
-                        confined)
+                        confined, len(loop.field.cells))
 
 
 def _over_denominator(closed, plan: Plan, discrete: bool):
@@ -235,18 +262,19 @@ def _polynomial(expressions, variables):
         return None
 
 
-def _functions(n: int, field, denominator, b, shapes, pieces: Pieces, deadline: float,
+def _functions(n: int, field: PolynomialField, b, shapes, pieces: Pieces, deadline: float,
                discrete: bool, partial: bool = False):
     """({"V": V, "B": b for RAR}, levels, V's degree, margin, whether confined) or None;
-    the field is field / denominator (denominator > 0 on D), or the map. Where
+    the field is N / Q (Q > 0 on D), or the map N. Where
     `partial` (no controller), RAR's B alone when no V is found (degree 0): V's program
     asks for a decrease on all of D outside G, which a basin smaller than D rules out;
     and V's programs with a growth rate are tried too."""
     for rate, half, asked, bound in shapes:
         if time.monotonic() > deadline:
             return None
-        program = _ReachProgram(n, field, denominator, asked, half, discrete, rate, bound)
-        if program.count > MAX_VARIABLES:
+        program = ReachProgram(n, field, asked, half, discrete, rate, bound)
+        if program.count > (FACTS_MAX_VARIABLES if field.facts and not field.cells
+                            else MAX_VARIABLES):
             continue
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
@@ -274,8 +302,8 @@ def _shapes(pieces: Pieces, growing: bool) -> list[tuple[float, int, Pieces, flo
     return shapes
 
 
-def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool,
-             denominator: P.Polynomial | None = None):
+def _barrier(n: int, field: PolynomialField, pieces: Pieces, deadline: float,
+             discrete: bool):
     """B <= 0 on G, B > 0 on D outside F, dB/dt <= -mu B (for a map B(f(x)) - B(x)
     <= -mu B; for a field N / Q, grad B . N <= -mu B Q) on D, of degree 2, then 4 (a
     hardening spring's x^3 outgrows every quadratic's decay on D: probe54/o07); else the
@@ -288,59 +316,9 @@ def _barrier(n: int, field, pieces: Pieces, deadline: float, discrete: bool,
                                               rates):
         if time.monotonic() > deadline:
             return None
-        program = BarrierProgram(n, field, [pieces.goal], pieces.outside_final, region,
-                                 half, mu, denominator, discrete=discrete)
+        program = BarrierProgram(n, field.numerators, [pieces.goal], pieces.outside_final,
+                                 region, half, mu, field.denominator, discrete=discrete)
         x = program.solve({program.margin: -1.0}, deadline - time.monotonic())
         if x is not None and x[program.margin] > MIN_MARGIN:
             return program.exact_b(x)
     return None
-
-
-class _ReachProgram(Program):
-    def __init__(self, n: int, field, denominator, pieces: Pieces, half: int,
-                 discrete: bool, rate: float = 0.0, bound: float = BOUND):
-        super().__init__(n, searches=True)
-        self.basis = P.monomials(n, 0, 2 * half)
-        self.coefficients = self.unknown_polynomial(self.basis, bound)
-        self.margin = self.scalar()
-        self.at_most.append(({self.margin: 1.0}, 1.0))
-        terms = [{m: Fraction(1)} for m in self.basis]
-        negated = [(v, P.scale(t, -1)) for v, t in zip(self.coefficients, terms)]
-        for piece in pieces.initial:
-            self.require(negated, piece)
-        for piece in pieces.boundary:
-            self.require(list(zip(self.coefficients, terms)), piece)
-        # grad V . N <= -γ Q, that is dV/dt <= -γ (for a map V(f(x)) - V(x) <= -γ); with
-        # a rate λ, grad V . N <= (λ V - γ) Q: the same where V <= 0
-        growth = Fraction(rate).limit_denominator(1000)
-        decrease = [(v, P.add(P.scale(P.change(t, field, discrete), -1),
-                              P.scale(P.multiply(t, denominator), growth)))
-                    for v, t in zip(self.coefficients, terms)]
-        stay = pieces.stay
-        for piece in pieces.outside_goal if stay is None else stay.decrease:
-            self.require(decrease, piece, P.scale(denominator, -GAMMA))
-        self.beta = None
-        if stay is not None:  # V - β > 0 on F outside the outer ball, < 0 on the inner
-            self.beta = self.scalar()
-            self.at_most += [({self.beta: 1.0}, bound), ({self.beta: -1.0}, bound)]
-            one = P.constant(1, n)
-            above = list(zip(self.coefficients, terms)) + [(self.beta, P.scale(one, -1))]
-            for piece in stay.above:
-                self.require(above, piece)
-            self.require(negated + [(self.beta, one)], stay.inner)
-            if discrete:  # and V(f(x)) < β there: a step from the inner ball stays below β
-                image = [(v, P.scale(P.compose(t, field), -1))
-                         for v, t in zip(self.coefficients, terms)]
-                self.require(image + [(self.beta, one)], stay.inner)
-
-    def levels(self, x) -> dict:
-        """β (RSWA) as a short decimal, else nothing."""
-        return {} if self.beta is None else {"beta": decimal(x[self.beta], DECIMALS)}
-
-    def require(self, terms, constraints, constant=None) -> None:
-        """sum of terms (+ constant) - e >= 0 on the piece."""
-        self.require_nonnegative(terms, constraints, (self.margin, P.constant(1, self.n)),
-                                 constant)
-
-    def exact_v(self, x) -> P.Polynomial:
-        return rounded(x, self.basis, self.coefficients, DECIMALS)

@@ -49,7 +49,8 @@ from fossil_dsl.engine.polynomial_field import PolynomialField, exact_field, pad
 from fossil_dsl.engine.quadratic_shapes import lqr_controllers
 from fossil_dsl.engine.sos import (Inexact, faces, interval_products, rounded, set_constraints,
                                    set_pieces, squared_norm)
-from fossil_dsl.engine.sos_reach import BOUND, DECIMALS, MIN_MARGIN, ReachFinding
+from fossil_dsl.engine.reach_program import BOUND, DECIMALS
+from fossil_dsl.engine.sos_reach import MIN_MARGIN, ReachFinding
 from fossil_dsl.engine.surrogate import polynomial_field
 from fossil_dsl.ir import polynomials as P
 from fossil_dsl.ir import traversal

@@ -24,9 +24,9 @@ Facts for |a| <= L, with the constants below rounded the safe way from arb's enc
 - cos (L <= 3): (1 - cos a)/a^2 decreases in |a|, so t <= 1 - c a^2, c = (1 - cos L)/L^2.
 - exp, for lo <= a <= hi: below the chord, t <= E(lo) + (a - lo)(E(hi) - E(lo))/(hi - lo)
   with E an upper bound of exp (convexity).
-- sin, cos, for a range at most 1/2 wide without 0 inside: within a rounded-up ε of
-  their quadratic Taylor polynomial at its middle (taylor_facts.py); these replace the
-  sector facts there.
+- sin, cos, tanh, for a range at most 1/2 wide without 0 inside: within a rounded-up ε
+  of their quadratic Taylor polynomial at its middle (taylor_facts.py); these replace
+  the sector facts there.
 Other functions (log, sqrt, tan) become a variable with no fact; abs stays (solvers
 encode it). tests/test_atom_facts.py checks every fact at many points against sympy at 60 digits.
 """
@@ -92,6 +92,8 @@ def _cos(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
 def _sigmoid(func: str, square_bound: Fraction):
     """tanh and atan: the same facts, with their own ratio and bound."""
     def facts(a: E.Expr, t: E.Expr, reach) -> list[L.Formula]:
+        if func == "tanh" and narrow(reach):
+            return [_square_at_most(t, square_bound)] + taylor_facts(func, a, t, reach)
         width = _width(reach)
         nearer = _minus_cube(a, Fraction(1, 3)) if width is None else \
             _scaled(_ratio(func, width), a)

@@ -7,7 +7,8 @@ from typing import Sequence
 from fossil_dsl.ir import logic as L
 from fossil_dsl.ir.enclosure import upward_rounding
 from fossil_dsl.solvers.api import UnsupportedTheory
-from fossil_dsl.solvers.interval_backend import _Compiler, _contract_to_fixpoint
+from fossil_dsl.solvers.codac_compiler import Compiler
+from fossil_dsl.solvers.interval_backend import _contract_to_fixpoint
 
 
 def hull(formula: L.Formula, names: Sequence[str]) -> list[tuple[float, float]] | None:
@@ -15,7 +16,7 @@ def hull(formula: L.Formula, names: Sequence[str]) -> list[tuple[float, float]] 
     if it is empty or unbounded, or the formula is outside the procedure's theory."""
     with upward_rounding() as codac:
         try:
-            contractor = _Compiler(codac, names).formula(formula)
+            contractor = Compiler(codac, names).formula(formula)
         except UnsupportedTheory:
             return None
         if contractor is None:
