@@ -70,3 +70,16 @@ def test_the_tanh_network_is_certified_by_the_celled_program():
     result = fossil_dsl.synthesise(fossil_dsl.load(NETWORK), seed=0, timeout=120)
     assert result.certified and result.kernel.certified, result.summary()
     assert "cells of D" in result.strategy, result.strategy
+
+
+def test_a_v_found_with_the_facts_gets_the_stand_in_s_longer_queries():
+    # probe76/az24: its quartic V's decrease was 9 boxes short of a proof after 5 s
+    import time
+    from dataclasses import replace
+    from fossil_dsl.engine.proving import STAND_IN_QUERY_SECONDS, budgets
+    finding = sos_reach.ReachFinding({}, {}, None, np.zeros(0), 4, 0.08, 2.0, {},
+                                     abstracted=True)
+    deadline = time.monotonic() + 100
+    assert budgets(finding, 5.0, deadline)[1] >= STAND_IN_QUERY_SECONDS
+    assert budgets(replace(finding, abstracted=False), 5.0, deadline)[1] \
+        < STAND_IN_QUERY_SECONDS

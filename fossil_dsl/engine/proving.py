@@ -47,8 +47,11 @@ def budgets(finding, floor: float, deadline: float) -> tuple[float, float]:
     a stand-in's, the conditions with elementary functions are proved by the solvers
     (probe55/p07: interval), and where the stand-in misled the program the solvers' pass
     finds that in a fraction of a second (probe48/c03: 5 s of refuting to no end before);
-    else twice the program's time, at least `floor`."""
-    if finding.stand_in:
+    likewise where the functions were variables bounded by their facts (probe76/az24's
+    quartic V, found with the facts of tanh on D: its decrease not refuted, and the
+    interval procedure's query 9 boxes short of a proof after 5 s, proved with longer
+    queries, the kernel's proof 7 s); else twice the program's time, at least `floor`."""
+    if finding.stand_in or getattr(finding, "abstracted", False):
         share = STAND_IN_SHARE * (deadline - time.monotonic())
         return 2 * finding.seconds, max(STAND_IN_QUERY_SECONDS, share)
     return max(floor, 2 * finding.seconds), SOS_QUERY_SECONDS

@@ -93,6 +93,7 @@ class ReachFinding:
     stand_in: int = 0  # the degree of the field's polynomial stand-in (0: none)
     confined: bool = False  # V > 0 outside a box round I and G (Pieces.confined)
     cells: int = 0  # cells of D with their own facts (polynomial_field.celled_field)
+    abstracted: bool = False  # the functions were variables bounded by their facts
 
     def describe(self) -> str:
         if not self.degree:
@@ -224,7 +225,7 @@ def _finding(plan: Plan, found, loop: _Loop, centre, operating, started: float) 
                         set_point_bias(operating, loop.gain, centre), degree, margin,
                         time.monotonic() - started, levels,
                         P.degree(formulas["B"]) if "B" in formulas else 0, loop.stand_in,
-                        confined, len(loop.field.cells))
+                        confined, len(loop.field.cells), bool(loop.field.facts))
 
 
 def _over_denominator(closed, plan: Plan, discrete: bool):
