@@ -119,7 +119,9 @@ def test_saturated_actuators_get_a_reach_v_from_the_ellipsoid_with_a_small_gain(
     assert found[0].levels == {}
     result = fossil_dsl.synthesise(fossil_dsl.load(SATURATED), seed=0, timeout=60)
     assert result.certified and result.kernel.certified, result.summary()
-    assert result.strategy.startswith("the linearisation's quadratic V and a linear controller")
+    # since session 77 the reach program with tanh's facts finds a quadratic V first
+    assert result.strategy.startswith(("the linearisation's quadratic V and a linear controller",
+                                       "sum-of-squares programming")), result.strategy
     result.save(tmp_path / "saturated")
     checks = recheck(tmp_path / "saturated", timeout=30)
     assert checks and all(c.reproved for c in checks), checks
